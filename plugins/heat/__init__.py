@@ -1,0 +1,13 @@
+"""Heat conducted between colliding particles: contact models A, B, C of Kosinski et al.
+(2014), Int. J. Heat Mass Transfer 70, 674-687, with the heat of Sun & Chen (1988).
+
+Public API (SI units throughout):
+- ``Pair`` (and ``Pair.wall``): the two bodies; ``PAPER_SET`` the paper's parameters;
+- ``collide(v0, pair, model)``: one collision by the exact path -> ``Collision``;
+- ``MODELS`` / ``get_model``: the registry of contact models "A", "B", "C".
+"""
+from plugins.heat.exact import Collision, collide
+from plugins.heat.models import MODELS, get_model
+from plugins.heat.pair import PAPER_SET, Pair, effective_modulus
+
+__all__ = ["Collision", "collide", "MODELS", "get_model", "PAPER_SET", "Pair", "effective_modulus"]

@@ -1,0 +1,1 @@
+"""The Python host: scene loading, engine bridges, the coupling loop and the CLI."""

@@ -1,0 +1,5 @@
+import sys
+
+from pyhost.cli import main
+
+sys.exit(main())
