@@ -54,7 +54,7 @@ def solve(model: str, v: float, b1: float, b2: float, c: float,
     x_top = law.peak(v)
     A_max, F_max = float(law.a2(x_top)), float(law.force(x_top))
     tau_c, t_max = law.time_from_top(v, x_top, rtol)
-    s_r, rho = RECOVERY_LAWS[m.recovery](law, x_top)
+    s_r, rho = (float(r) for r in RECOVERY_LAWS[m.recovery](law, x_top))
     v1 = rho**0.25 * s_r**1.25                                         # eqs. (22), (28)
     t_r = K_HERTZ * s_r / v1                                           # eqs. (23), (29)
     Q = heat_integral(law, x_top, A_max, tau_c, t_r, rtol)
@@ -137,10 +137,10 @@ class Collision:
         return not self.flags
 
 
-def closed_form_heat(pair: Pair, a_max, t_coll, elastic):
-    """Eq. (31) (elastic, 0.87) or eq. (33) (fully plastic, 0.88) [J]."""
-    prefactor = np.where(elastic, 0.87, 0.88)
-    return prefactor * np.pi * a_max**2 * pair.dT * np.sqrt(t_coll) / pair.sigma
+def closed_form_heat(a_max, t_coll, elastic, dT, sigma):
+    """Eq. (31) (elastic, 0.87) or eq. (33) (plastic, 0.88) [J], from a_max [m], t_coll [s],
+    dT [K] and sigma of eq. (2)."""
+    return np.where(elastic, 0.87, 0.88) * np.pi * a_max**2 * dT * np.sqrt(t_coll) / sigma
 
 
 def check_speed(v0) -> np.ndarray:
@@ -170,5 +170,5 @@ def collide(v0: float, pair: Pair | None = None, model: str = "A", rtol: float =
         F_max=d["F_max"] * pair.F_y, delta_r=d["s_r"] * dy, delta_f=(d["x_max"] - d["s_r"]) * dy,
         R_bar=d["rho"] * pair.Rstar, t_r=t_r, v1=v1, e=e, t_coll=t_max + t_r,
         Q=d["Q"] * float(pair.Q_scale),
-        Q_closed_form=float(closed_form_heat(pair, a_max, t_max + t_r, d["regime"] == "elastic")),
+        Q_closed_form=float(closed_form_heat(a_max, t_max + t_r, d["regime"] == "elastic", pair.dT, pair.sigma)),
         regime=d["regime"], flags=tuple(flags_for(d["x_max"], d["s_r"], e)), history=hist)
