@@ -1,0 +1,52 @@
+"""Bad input raises ValueError naming the parameter; the CLI prints one line and exits 2."""
+import math
+import subprocess
+import sys
+
+import pytest
+
+from plugins.heat import Pair, collide, get_model
+from plugins.heat.fast import collide_fast
+
+
+@pytest.mark.parametrize("name", ["R1", "R2", "rho1", "rho2", "Estar", "Y", "b1", "c1", "c2", "k1", "k2"])
+@pytest.mark.parametrize("value", [0.0, -1.0, math.nan])
+def test_nonpositive_or_nan_parameter_named(name, value):
+    with pytest.raises(ValueError, match=name):
+        Pair(**{name: value})
+
+
+def test_b2_not_above_b1():
+    with pytest.raises(ValueError, match="b2"):
+        Pair(b1=2.0, b2=2.0)
+
+
+def test_nan_temperature_difference():
+    with pytest.raises(ValueError, match="dT"):
+        Pair(dT=math.nan)
+
+
+@pytest.mark.parametrize("v0", [0.0, -1.0, math.nan, math.inf])
+def test_bad_speed(v0):
+    with pytest.raises(ValueError, match="v0"):
+        collide(v0)
+    with pytest.raises(ValueError, match="v0"):
+        collide_fast([1.0, v0])
+
+
+def test_unknown_model_lists_choices():
+    with pytest.raises(ValueError, match="A, B, C"):
+        get_model("D")
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "pyhost", "collide", *args], capture_output=True, text=True)
+
+
+@pytest.mark.parametrize("args,word", [(["--R1", "-2e-3"], "R1"), (["--v0", "0"], "v0"),
+                                       (["--b2", "1.0"], "b2"), (["--Y", "nan"], "Y")])
+def test_cli_bad_input_one_line_exit_2(args, word):
+    r = run_cli(*args)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0], r.stderr
