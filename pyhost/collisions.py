@@ -1,0 +1,163 @@
+"""Collisions out of the DEM's contact lists: impact speed, start and end, heat exchange.
+
+Pure functions and one small state holder, no engine calls, so that the coupling loop can
+be tested without engines. SI units.
+
+How a contact is classified. A contact opens when a pair (or a particle and a wall) shows
+up in the contact list and closes when it leaves it. At the first sample in contact the
+impact speed is recovered from the DEM's own contact law (``DemHertz.impact_speed``), and
+the collision's heat Q is computed by the plugin and exchanged at once, with the
+temperatures of that moment. That heat accounts for the first t_coll of the contact, the
+collision's duration under the real material's model. A contact that is still open after
+t_coll is *enduring*. From then on it conducts only through the enduring-contact effect, if
+the scene enables it, and only for the time beyond t_coll. So no stretch of a contact's
+time is counted twice.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+WALL_BASE = 1 << 30
+"""Partner ids at or above this are walls (WALL_BASE + wall index); particle ids stay below."""
+
+
+def restitution_beta(e: float) -> float:
+    """LIGGGHTS' damping ratio beta = ln e / (ln^2 e + pi^2)^(1/2) (< 0 for e < 1)."""
+    if not 0.0 < e <= 1.0:
+        raise ValueError(f"DEM restitution must be in (0, 1], got {e!r}")
+    if e == 1.0:
+        return 0.0
+    return math.log(e) / math.sqrt(math.log(e) ** 2 + math.pi**2)
+
+
+@dataclass(frozen=True)
+class DemHertz:
+    """The DEM's normal contact law, LIGGGHTS ``model hertz`` (normal_model_hertz.h):
+    F = (4/3) Y* (R* delta)^(1/2) delta + 2 (5/6)^(1/2) |beta| (2 Y* (R* delta)^(1/2) m*)^(1/2) ddelta,
+    with Y* the DEM's effective (softened) modulus [Pa] and beta from its restitution e."""
+
+    Ystar: float
+    e: float
+
+    def __post_init__(self):
+        if not self.Ystar > 0:
+            raise ValueError(f"DEM effective modulus must be positive, got {self.Ystar!r}")
+        restitution_beta(self.e)
+
+    def force(self, delta, ddelta, Rstar, mstar):
+        """Normal force [N] at overlap delta [m] and overlap rate ddelta [m/s]."""
+        root = np.sqrt(Rstar * delta)
+        damping = 2.0 * math.sqrt(5.0 / 6.0) * abs(restitution_beta(self.e)) * np.sqrt(2.0 * self.Ystar * root * mstar)
+        return 4.0 / 3.0 * self.Ystar * root * delta + damping * ddelta
+
+    def impact_speed(self, delta, ddelta, Rstar, mstar, steps: int = 16):
+        """Normal impact speed [m/s] of contacts first seen at overlap delta [m] with overlap
+        rate ddelta [m/s] (> 0 while approaching): the DEM's law integrated back to delta = 0.
+
+        Approaching contacts (ddelta > 0), vectorised: the square speed E = v^2 obeys
+        dE/ddelta = -2 F/m*, which stays regular at the turning point (where dv/ddelta does
+        not); with delta = delta1 u^4 it is also smooth at touch, and classical RK4 integrates
+        it from u = 1 to 0 (relative error ~3e-6 at 16 steps). Contacts seen later (past half
+        their undamped impact energy, or past their turning point) are integrated back in time
+        one by one (solve_ivp), through the turning point, to delta = 0.
+        """
+        delta, ddelta = np.broadcast_arrays(np.asarray(delta, float), np.asarray(ddelta, float))
+        Rstar = np.broadcast_to(np.asarray(Rstar, float), delta.shape)
+        mstar = np.broadcast_to(np.asarray(mstar, float), delta.shape)
+        out = np.empty(delta.shape)
+        elastic_energy = 16.0 / 15.0 * self.Ystar * np.sqrt(Rstar) * delta**2.5 / mstar
+        go = (ddelta > 0) & (ddelta**2 > elastic_energy)      # well before the turning point
+        if go.any():
+            out[go] = self._back_in_overlap(delta[go], ddelta[go], Rstar[go], mstar[go], steps)
+        for k in np.flatnonzero(~go):
+            out.flat[k] = self._back_in_time(delta.flat[k], ddelta.flat[k], Rstar.flat[k], mstar.flat[k])
+        return out
+
+    def _back_in_overlap(self, d1, v1, R, m, steps):
+        def dE_du(u, E):
+            return -8.0 * d1 * u**3 * self.force(d1 * u**4, np.sqrt(np.maximum(E, 0.0)), R, m) / m
+        E, h = v1 * v1, -1.0 / steps
+        for n in range(steps):
+            u = 1.0 + n * h
+            k1 = dE_du(u, E)
+            k2 = dE_du(u + h / 2, E + h / 2 * k1)
+            k3 = dE_du(u + h / 2, E + h / 2 * k2)
+            k4 = dE_du(u + h, E + h * k3)
+            E = E + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        return np.sqrt(E)
+
+    def _back_in_time(self, d1, v1, R, m):
+        rhs = lambda t, y: [y[1], -self.force(max(y[0], 0.0), y[1], R, m) / m]
+        touch = lambda t, y: y[0]
+        touch.terminal, touch.direction = True, 0
+        t_scale = 10.0 * (m**2 / (self.Ystar**2 * R * max(abs(v1), 1e-6))) ** 0.2 + 10 * d1 / max(abs(v1), 1e-12)
+        sol = solve_ivp(rhs, (0.0, -t_scale), [d1, v1], events=touch, rtol=1e-10, atol=1e-30 + 1e-12 * d1)
+        if not sol.t_events[0].size:
+            raise ValueError(f"contact at overlap {d1:.3g} m, rate {v1:.3g} m/s never separates backwards")
+        return float(sol.y_events[0][0][1])
+
+
+def contact_keys(i, j):
+    """One int64 key per contact: i and j are particle ids (j may be WALL_BASE + wall)."""
+    i, j = np.asarray(i, np.int64), np.asarray(j, np.int64)
+    if np.any(np.minimum(i, j) < 0) or np.any(np.minimum(i, j) >= WALL_BASE):
+        raise ValueError(f"particle ids must lie in [0, {WALL_BASE})")
+    lo, hi = np.minimum(i, j), np.maximum(i, j)
+    return (lo << 31) | hi
+
+
+@dataclass
+class ContactTracker:
+    """The open contacts between two samples of the contact list.
+
+    ``update(keys)`` returns the indices (into keys) of contacts that opened since the last
+    sample and the keys of those that closed; the host stores per-contact data alongside.
+    """
+
+    open_keys: np.ndarray = None
+
+    def __post_init__(self):
+        self.open_keys = np.empty(0, np.int64) if self.open_keys is None else self.open_keys
+
+    def update(self, keys: np.ndarray):
+        keys = np.asarray(keys, np.int64)
+        if np.unique(keys).size != keys.size:
+            raise ValueError("contact list holds the same contact twice (is newton off?)")
+        opened = np.flatnonzero(~np.isin(keys, self.open_keys))
+        closed = self.open_keys[~np.isin(self.open_keys, keys)]
+        self.open_keys = keys.copy()
+        return opened, closed
+
+
+def exchange_heat(T, C, i, j, Q, T_wall=None):
+    """Move heat Q [J] (> 0 from i to j) between bodies, one collision after the other.
+
+    T [K] and C = m c [J/K] are per particle; j >= WALL_BASE is wall j - WALL_BASE, with
+    temperature T_wall[wall] (None or NaN: adiabatic, no exchange). No collision carries more
+    heat than would equalise the two temperatures: such a Q is capped. Returns the heat
+    actually moved per collision, the number capped, and the heat that entered the
+    particles from walls [J]. sum(C T) changes by exactly that wall heat (to rounding).
+    """
+    moved = np.zeros(len(Q))
+    capped, from_walls = 0, 0.0
+    for k, (a, b, q) in enumerate(zip(np.asarray(i), np.asarray(j), np.asarray(Q, float))):
+        if b >= WALL_BASE:
+            tw = np.nan if T_wall is None else T_wall[b - WALL_BASE]
+            if np.isnan(tw):
+                continue
+            limit = (T[a] - tw) * C[a]
+        else:
+            limit = (T[a] - T[b]) * C[a] * C[b] / (C[a] + C[b])
+        if abs(q) > abs(limit) or q * limit < 0:
+            q, capped = (limit if q * limit > 0 else 0.0), capped + 1
+        T[a] -= q / C[a]
+        if b >= WALL_BASE:
+            from_walls -= q
+        else:
+            T[b] += q / C[b]
+        moved[k] = q
+    return moved, capped, from_walls

@@ -1,0 +1,101 @@
+"""The host's collision logic without engines: impact speed, contact tracking, heat exchange."""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat
+
+LAW = DemHertz(Ystar=5e7, e=0.8)          # a softened DEM contact
+R, M = 1e-3, 2e-5                          # effective radius [m] and mass [kg]
+
+
+def dem_collision(v0):
+    """Forward integration of the DEM law from touch: overlap and its rate over time."""
+    rhs = lambda t, y: [y[1], -LAW.force(max(y[0], 0.0), y[1], R, M) / M]
+    sep = lambda t, y: y[0] if t > 0 else 1.0
+    sep.terminal, sep.direction = True, -1
+    return solve_ivp(rhs, (0, 1.0), [0.0, v0], events=sep, dense_output=True, rtol=1e-12, atol=1e-20)
+
+
+@pytest.mark.parametrize("v0", [0.01, 0.3, 5.0])
+@pytest.mark.parametrize("fraction", [0.05, 0.3, 0.45])
+def test_impact_speed_recovered_while_approaching(v0, fraction):
+    sol = dem_collision(v0)
+    d, dd = sol.sol(fraction * sol.t_events[0][0])
+    assert dd > 0
+    assert LAW.impact_speed(d, dd, R, M)[()] == pytest.approx(v0, rel=1e-5)
+
+
+@pytest.mark.parametrize("v0", [0.01, 5.0])
+def test_impact_speed_recovered_after_turning_point(v0):
+    sol = dem_collision(v0)
+    d, dd = sol.sol(0.8 * sol.t_events[0][0])
+    assert dd < 0
+    assert LAW.impact_speed(d, dd, R, M)[()] == pytest.approx(v0, rel=1e-6)
+
+
+def test_dem_law_rebounds_with_about_its_restitution():
+    # LIGGGHTS' beta is exact for a linear spring; with Hertz the rebound is within ~2 %
+    sol = dem_collision(1.0)
+    assert -sol.y_events[0][0][1] == pytest.approx(LAW.e, rel=2e-2)
+
+
+def test_bad_dem_parameters():
+    with pytest.raises(ValueError, match="restitution"):
+        DemHertz(Ystar=1e7, e=1.5)
+    with pytest.raises(ValueError, match="modulus"):
+        DemHertz(Ystar=-1.0, e=0.5)
+
+
+def test_contact_keys_order_free_and_walls_distinct():
+    assert contact_keys(3, 7) == contact_keys(7, 3)
+    assert contact_keys(3, WALL_BASE) != contact_keys(3, 7)
+    with pytest.raises(ValueError):
+        contact_keys(-1, 2)
+
+
+def test_tracker_reports_opened_and_closed():
+    tr = ContactTracker()
+    a, b, c = contact_keys([1, 2, 3], [2, 3, WALL_BASE])
+    opened, closed = tr.update(np.array([a, b]))
+    assert list(opened) == [0, 1] and closed.size == 0
+    opened, closed = tr.update(np.array([b, c]))
+    assert list(opened) == [1] and list(closed) == [a]
+    opened, closed = tr.update(np.array([], np.int64))
+    assert opened.size == 0 and sorted(closed) == sorted([b, c])
+    with pytest.raises(ValueError, match="twice"):
+        tr.update(np.array([a, a]))
+
+
+def test_heat_exchange_conserves_and_caps():
+    rng = np.random.default_rng(3)
+    T = rng.uniform(300, 400, 50)
+    C = rng.uniform(1e-3, 1e-1, 50)
+    i, j = rng.integers(0, 50, 400), rng.integers(0, 50, 400)
+    keep = i != j
+    i, j = i[keep], j[keep]
+    Q = (T[i] - T[j]) * rng.uniform(0, 0.2, i.size) * 1e-2      # sized to cap some
+    Q[::7] *= 1e4
+    total = np.sum(C * T)
+    moved, capped, from_walls = exchange_heat(T, C, i, j, Q)
+    assert from_walls == 0.0 and capped > 0
+    assert np.sum(C * T) == pytest.approx(total, rel=1e-12)
+    assert T.min() >= 300 - 1e-9 and T.max() <= 400 + 1e-9     # capping never overshoots
+
+
+def test_heat_exchange_with_walls_balances():
+    T = np.array([350.0, 300.0])
+    C = np.array([0.01, 0.02])
+    T_wall = np.array([320.0, np.nan])          # wall 0 fixed at 320 K, wall 1 adiabatic
+    i = np.array([0, 1, 0])
+    j = np.array([WALL_BASE, WALL_BASE, WALL_BASE + 1])
+    before = np.sum(C * T)
+    moved, capped, from_walls = exchange_heat(T, C, i, j, np.array([0.1, -0.05, 1.0]), T_wall)
+    assert moved[2] == 0.0                       # adiabatic wall
+    assert np.sum(C * T) - before == pytest.approx(from_walls, rel=1e-12)
+    assert T[0] == pytest.approx(340.0) and T[1] == pytest.approx(302.5)
+    # a wall collision that would cool the particle below the wall is capped at the wall's temperature
+    _, capped, _ = exchange_heat(T, C, np.array([0]), np.array([WALL_BASE]), np.array([10.0]), T_wall)
+    assert capped == 1 and T[0] == pytest.approx(320.0)
