@@ -1,0 +1,268 @@
+"""The scene: one declarative ``case.toml`` per case, every value given once, SI units.
+
+Loaded into frozen dataclasses. A wrong key, a wrong type or an impossible value is reported
+as ``SceneError`` naming the file and the key (``case.toml: materials.glass.density: must be
+> 0, got -1``) before any engine starts. ``Scene.effects_summary()`` tells what the host will
+build: no fluid solver for a dry scene, no contact extraction for an isothermal scene
+without restitution feedback.
+
+Example::
+
+    [effects]
+    fluid = false                 # OpenFOAM solver process
+    contact_heat = "A"            # none, A, B, C (plugins.heat models)
+    heat_path = "fast"            # exact, fast
+    restitution_feedback = false  # e(v0) of the model applied at contact end
+    enduring_conduction = false   # conduction through contacts that outlast a collision
+
+    [materials.steel]             # the real material, for the contact models
+    density = 7800.0
+    youngs_modulus = 210e9
+    poisson_ratio = 0.3
+    yield_stress = 300e6
+    heat_capacity = 470.0
+    conductivity = 45.0
+    dem = { youngs_modulus = 5e7, restitution = 0.9, friction = 0.3 }   # softened DEM contact
+
+    [[particles]]
+    material = "steel"
+    count = 2
+    radius = 2e-3
+    temperature = 400.0
+    region = [0.0, 0.01, 0.0, 0.01, 0.0, 0.01]
+
+    [domain]
+    box = [0.0, 0.1, 0.0, 0.01, 0.0, 0.2]
+
+    [time]
+    dem_step = 1e-6
+    end = 0.01
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from plugins.heat import MODELS
+
+
+class SceneError(ValueError):
+    """A problem in a scene file, naming the file and the key."""
+
+
+def _check(value, rule: str) -> str | None:
+    """None if value satisfies rule, else the complaint."""
+    if rule == ">0" and not value > 0:
+        return f"must be > 0, got {value!r}"
+    if rule == ">=0" and not value >= 0:
+        return f"must be >= 0, got {value!r}"
+    if rule == "0<e<=1" and not 0 < value <= 1:
+        return f"must be in (0, 1], got {value!r}"
+    if rule == "poisson" and not -1 < value < 0.5:
+        return f"must be in (-1, 0.5), got {value!r}"
+    if rule.startswith("in:") and value not in rule[3:].split(","):
+        return f"must be one of {rule[3:].replace(',', ', ')}, got {value!r}"
+    return None
+
+
+def spec(rule: str = "", default=dataclasses.MISSING, doc: str = ""):
+    """A scene field with a validity rule (see ``_check``) and its documentation with units."""
+    kw = {} if default is dataclasses.MISSING else (
+        {"default_factory": lambda: default} if isinstance(default, (list, dict)) else {"default": default})
+    return field(metadata={"rule": rule, "doc": doc}, **kw)
+
+
+@dataclass(frozen=True)
+class Effects:
+    fluid: bool = spec(default=False, doc="run the OpenFOAM fluid solver")
+    contact_heat: str = spec("in:none," + ",".join(sorted(MODELS)), "none", "collision heat model")
+    heat_path: str = spec("in:exact,fast", "fast", "plugin evaluation path")
+    restitution_feedback: bool = spec(default=False, doc="apply the model's e(v0) at contact end")
+    enduring_conduction: bool = spec(default=False, doc="conduct through contacts that outlast a collision")
+    wall_heat: bool = spec(default=True, doc="collisions with walls at a fixed temperature exchange heat")
+
+
+@dataclass(frozen=True)
+class DemContact:
+    youngs_modulus: float = spec(">0", doc="softened Young's modulus of the DEM [Pa]")
+    restitution: float = spec("0<e<=1", doc="DEM coefficient of restitution [-]")
+    friction: float = spec(">=0", 0.3, "Coulomb friction coefficient [-]")
+    poisson_ratio: float = spec("poisson", 0.3, "DEM Poisson ratio [-]")
+
+
+@dataclass(frozen=True)
+class Material:
+    density: float = spec(">0", doc="[kg/m^3]")
+    youngs_modulus: float = spec(">0", doc="real Young's modulus [Pa]")
+    poisson_ratio: float = spec("poisson", doc="[-]")
+    yield_stress: float = spec(">0", doc="[Pa]")
+    heat_capacity: float = spec(">0", doc="[J/(kg K)]")
+    conductivity: float = spec(">0", doc="[W/(m K)]")
+    dem: DemContact = spec(doc="the DEM's softened contact")
+    b1: float = spec(">0", 1.1, "mean pressure at first yield / Y [-]")
+    b2: float = spec(">0", 2.8, "fully plastic mean pressure / Y [-]")
+
+
+@dataclass(frozen=True)
+class Particles:
+    material: str = spec(doc="key of [materials]")
+    count: int = spec(">0", doc="number of particles")
+    radius: float = spec(">0", doc="[m]")
+    temperature: float = spec(">0", doc="initial temperature [K]")
+    region: list = spec(doc="xmin xmax ymin ymax zmin zmax where they are inserted [m]")
+    velocity: list = spec(default=[0.0, 0.0, 0.0], doc="initial velocity [m/s]")
+
+
+@dataclass(frozen=True)
+class Wall:
+    plane: str = spec("in:xlo,xhi,ylo,yhi,zlo,zhi", doc="which face of the box")
+    material: str = spec(doc="key of [materials]")
+    temperature: float = spec(">=0", 0.0, "fixed temperature [K]; 0 means adiabatic")
+
+
+@dataclass(frozen=True)
+class Domain:
+    box: list = spec(doc="xmin xmax ymin ymax zmin zmax [m]")
+    gravity: list = spec(default=[0.0, 0.0, -9.81], doc="[m/s^2]")
+    periodic: list = spec(default=[False, False, False], doc="periodic in x, y, z")
+
+
+@dataclass(frozen=True)
+class Fluid:
+    density: float = spec(">0", 1.2, "[kg/m^3]")
+    viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
+    inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the bottom [m/s]")
+    drag: str = spec("", "DiFelice", "drag law (pyhost.drag)")
+    cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
+
+
+@dataclass(frozen=True)
+class Time:
+    dem_step: float = spec(">0", doc="DEM time step [s]")
+    end: float = spec(">0", doc="simulated time [s]")
+    sample_every: int = spec(">0", 1, "DEM steps between contact samples")
+    couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
+
+
+@dataclass(frozen=True)
+class Output:
+    every: float = spec(">0", 1e-3, "interval between VTK frames [s]")
+    vtk: bool = spec(default=True, doc="write VTK time series")
+    pictures: bool = spec(default=True, doc="write PNG pictures")
+
+
+@dataclass(frozen=True)
+class Scene:
+    path: Path
+    effects: Effects
+    materials: dict
+    particles: list
+    domain: Domain
+    time: Time
+    walls: list
+    fluid: Fluid | None
+    output: Output
+
+    def effects_summary(self) -> dict:
+        """What the host builds for this scene."""
+        heat = self.effects.contact_heat != "none"
+        return dict(
+            fluid_solver=self.effects.fluid,
+            contact_extraction=heat or self.effects.restitution_feedback or self.effects.enduring_conduction,
+            collision_heat=heat,
+            restitution_feedback=self.effects.restitution_feedback,
+            enduring_conduction=self.effects.enduring_conduction,
+            wall_heat=heat and self.effects.wall_heat and any(w.temperature > 0 for w in self.walls),
+        )
+
+
+def _build(cls, data, where: str, file: str):
+    if not isinstance(data, dict):
+        raise SceneError(f"{file}: {where}: must be a table, got {type(data).__name__}")
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    hints = typing.get_type_hints(cls)
+    for key in data:
+        if key not in fields:
+            raise SceneError(f"{file}: {where}.{key}: unknown key; known: {', '.join(fields)}")
+    values = {}
+    for name, f in fields.items():
+        key = f"{where}.{name}"
+        if name not in data:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise SceneError(f"{file}: {key}: missing ({f.metadata.get('doc', '')})")
+            continue
+        value, kind = data[name], hints[name]
+        if dataclasses.is_dataclass(kind):
+            values[name] = _build(kind, value, key, file)
+            continue
+        if kind is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if not isinstance(value, kind) or (kind is not bool and isinstance(value, bool)):
+            raise SceneError(f"{file}: {key}: must be {kind.__name__}, got {value!r}")
+        if kind is float and not math.isfinite(value):
+            raise SceneError(f"{file}: {key}: must be finite, got {value!r}")
+        problem = _check(value, f.metadata.get("rule", "")) if f.metadata.get("rule") else None
+        if problem:
+            raise SceneError(f"{file}: {key}: {problem}")
+        values[name] = value
+    return cls(**values)
+
+
+def _box(values, key, file, n=6):
+    if len(values) != n or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        raise SceneError(f"{file}: {key}: must be {n} numbers, got {values!r}")
+    if n == 6 and any(values[k] >= values[k + 1] for k in (0, 2, 4)):
+        raise SceneError(f"{file}: {key}: each min must be below its max, got {values!r}")
+
+
+SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output")
+
+
+def load_scene(path) -> Scene:
+    """Read and validate a scene file; raises SceneError naming the file and the key."""
+    path = Path(path)
+    file = str(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SceneError(f"{file}: no such scene file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{file}: not valid TOML: {exc}") from None
+    for key in data:
+        if key not in SECTIONS:
+            raise SceneError(f"{file}: {key}: unknown section; known: {', '.join(SECTIONS)}")
+    for key in ("materials", "particles", "domain", "time"):
+        if key not in data:
+            raise SceneError(f"{file}: {key}: missing section")
+    effects = _build(Effects, data.get("effects", {}), "effects", file)
+    materials = {name: _build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
+    for name, m in materials.items():
+        if m.b2 <= m.b1:
+            raise SceneError(f"{file}: materials.{name}.b2: must exceed b1 ({m.b1}), got {m.b2}")
+    if not isinstance(data["particles"], list) or not data["particles"]:
+        raise SceneError(f"{file}: particles: must be one or more [[particles]] tables")
+    particles = [_build(Particles, p, f"particles[{k}]", file) for k, p in enumerate(data["particles"])]
+    walls = [_build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+    for where, items in (("particles", particles), ("walls", walls)):
+        for k, item in enumerate(items):
+            if item.material not in materials:
+                raise SceneError(f"{file}: {where}[{k}].material: unknown material {item.material!r}; "
+                                 f"known: {', '.join(materials)}")
+    for k, p in enumerate(particles):
+        _box(p.region, f"particles[{k}].region", file)
+        _box(p.velocity, f"particles[{k}].velocity", file, 3)
+    domain = _build(Domain, data["domain"], "domain", file)
+    _box(domain.box, "domain.box", file)
+    _box(domain.gravity, "domain.gravity", file, 3)
+    time = _build(Time, data["time"], "time", file)
+    if time.dem_step >= time.end:
+        raise SceneError(f"{file}: time.dem_step: must be below time.end ({time.end}), got {time.dem_step}")
+    fluid = _build(Fluid, data["fluid"], "fluid", file) if "fluid" in data else None
+    if effects.fluid and fluid is None:
+        raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
+    output = _build(Output, data.get("output", {}), "output", file)
+    return Scene(path, effects, materials, particles, domain, time, walls, fluid, output)

@@ -1,0 +1,89 @@
+"""Scene files: a valid one loads, every kind of mistake names the file and the key."""
+import pytest
+
+from pyhost.scene import SceneError, load_scene
+
+VALID = """
+[effects]
+contact_heat = "A"
+
+[materials.steel]
+density = 7800.0
+youngs_modulus = 210e9
+poisson_ratio = 0.3
+yield_stress = 300e6
+heat_capacity = 470
+conductivity = 45.0
+dem = { youngs_modulus = 5e7, restitution = 0.9 }
+
+[[particles]]
+material = "steel"
+count = 2
+radius = 2e-3
+temperature = 400.0
+region = [0.0, 0.01, 0.0, 0.01, 0.0, 0.01]
+
+[[walls]]
+plane = "zlo"
+material = "steel"
+temperature = 300.0
+
+[domain]
+box = [0.0, 0.1, 0.0, 0.01, 0.0, 0.2]
+
+[time]
+dem_step = 1e-6
+end = 0.01
+"""
+
+
+def write(tmp_path, text):
+    path = tmp_path / "case.toml"
+    path.write_text(text)
+    return path
+
+
+def test_valid_scene_loads_with_defaults(tmp_path):
+    s = load_scene(write(tmp_path, VALID))
+    assert s.materials["steel"].heat_capacity == 470.0          # int accepted as float
+    assert s.materials["steel"].dem.friction == 0.3             # default
+    assert s.time.sample_every == 1 and s.fluid is None
+    effects = s.effects_summary()
+    assert effects == dict(fluid_solver=False, contact_extraction=True, collision_heat=True,
+                           restitution_feedback=False, enduring_conduction=False, wall_heat=True)
+
+
+def test_dry_isothermal_scene_builds_nothing_extra(tmp_path):
+    s = load_scene(write(tmp_path, VALID.replace('contact_heat = "A"', 'contact_heat = "none"')))
+    summary = s.effects_summary()
+    assert not summary["fluid_solver"] and not summary["contact_extraction"] and not summary["wall_heat"]
+
+
+@pytest.mark.parametrize("old,new,message", [
+    ("count = 2", "count = 2\ncolour = 3", "particles[0].colour: unknown key"),
+    ("density = 7800.0", "density = -1.0", "materials.steel.density: must be > 0"),
+    ("radius = 2e-3", 'radius = "big"', "particles[0].radius: must be float"),
+    ("count = 2", "count = 2.5", "particles[0].count: must be int"),
+    ('contact_heat = "A"', 'contact_heat = "D"', "effects.contact_heat: must be one of none, A, B, C"),
+    ('material = "steel"\ncount', 'material = "glass"\ncount', "particles[0].material: unknown material"),
+    ("restitution = 0.9", "restitution = 1.5", "materials.steel.dem.restitution"),
+    ("end = 0.01", "end = 1e-7", "time.dem_step: must be below time.end"),
+    ("[domain]", "[domian]", "domian: unknown section"),
+    ("box = [0.0, 0.1,", "box = [0.2, 0.1,", "domain.box: each min must be below its max"),
+    ("yield_stress = 300e6\n", "", "materials.steel.yield_stress: missing"),
+    ("[effects]", "[effects]\nfluid = true", "fluid: missing section"),
+    ("dem_step = 1e-6", "dem_step = nan", "time.dem_step: must be finite"),
+])
+def test_mistakes_name_file_and_key(tmp_path, old, new, message):
+    assert old in VALID
+    path = write(tmp_path, VALID.replace(old, new, 1))
+    with pytest.raises(SceneError) as err:
+        load_scene(path)
+    assert str(path) in str(err.value) and message in str(err.value)
+
+
+def test_missing_file_and_broken_toml(tmp_path):
+    with pytest.raises(SceneError, match="no such scene file"):
+        load_scene(tmp_path / "nope.toml")
+    with pytest.raises(SceneError, match="not valid TOML"):
+        load_scene(write(tmp_path, "[effects\n"))
