@@ -11,7 +11,7 @@ import importlib
 import re
 import sys
 
-COMMANDS = ("collide", "demo")
+COMMANDS = ("collide", "demo", "fit")
 
 
 class UserError(Exception):

@@ -29,8 +29,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="contact model; 'all' gives each")
     p.add_argument("--v0", type=float, nargs="+", default=[1.0],
                    help="normal impact speed(s) [m/s]; several give a JSON list")
-    p.add_argument("--method", default="exact", choices=("exact", "fast"),
-                   help="exact: reference quadrature; fast: tables (relative error < 1e-6)")
+    p.add_argument("--method", default="exact", choices=("exact", "fast", "fit"),
+                   help="exact: reference quadrature; fast: tables (relative error < 1e-6); "
+                        "fit: fitted relations, e, t_coll and Q only (plugins/heat/fit.py: "
+                        "e to 5e-4, t_coll to 6 %%, Q to 2.5 %%)")
     p.add_argument("--wall", action="store_true",
                    help="body 2 is a flat wall (R2 = inf, m* = m1); rho2, c2, k2 describe the wall")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
@@ -52,7 +54,12 @@ def evaluate(args) -> list[dict]:
     models = sorted(MODELS) if args.model == "all" else [args.model]
     rows = []
     for model in models:
-        if args.method == "exact":
+        if args.method == "fit":
+            from plugins.heat.fit import collide_fit
+            out = collide_fit(np.array(args.v0), pair, model)
+            rows += [{"model": model, "v0": v, **{k: float(out[k][j]) for k in ("e", "t_coll", "Q")}}
+                     for j, v in enumerate(args.v0)]
+        elif args.method == "exact":
             rows += [{"model": model, "v0": v, **collide(v, pair, model).to_dict()} for v in args.v0]
         else:
             out = collide_fast(np.array(args.v0), pair, model)
@@ -74,6 +81,6 @@ def run(args) -> int:
     cols = ("model", "v0", "regime", "delta_max", "t_coll", "e", "Q", "Q_closed_form")
     print("  ".join(f"{c:>15}" for c in cols) + "  flags")
     for r in rows:
-        cells = [f"{r[c]:>15.6g}" if isinstance(r[c], float) else f"{r[c]:>15}" for c in cols]
-        print("  ".join(cells) + "  " + ",".join(r["flags"]))
+        cells = [f"{r[c]:>15.6g}" if isinstance(r.get(c), float) else f"{r.get(c, '-'):>15}" for c in cols]
+        print("  ".join(cells) + "  " + ",".join(r.get("flags", [])))
     return 0
