@@ -113,7 +113,8 @@ class Particles:
     count: int = spec(">0", doc="number of particles")
     radius: float = spec(">0", doc="[m]")
     temperature: float = spec(">0", doc="initial temperature [K]")
-    region: list = spec(doc="xmin xmax ymin ymax zmin zmax where they are inserted [m]")
+    region: list = spec(default=[], doc="xmin xmax ymin ymax zmin zmax where they are placed [m]")
+    positions: list = spec(default=[], doc="explicit centres [[x, y, z], ...] [m], instead of region")
     velocity: list = spec(default=[0.0, 0.0, 0.0], doc="initial velocity [m/s]")
 
 
@@ -253,7 +254,14 @@ def load_scene(path) -> Scene:
                 raise SceneError(f"{file}: {where}[{k}].material: unknown material {item.material!r}; "
                                  f"known: {', '.join(materials)}")
     for k, p in enumerate(particles):
-        _box(p.region, f"particles[{k}].region", file)
+        if bool(p.region) == bool(p.positions):
+            raise SceneError(f"{file}: particles[{k}]: give either region or positions")
+        if p.region:
+            _box(p.region, f"particles[{k}].region", file)
+        for x in p.positions:
+            _box(x, f"particles[{k}].positions", file, 3)
+        if p.positions and len(p.positions) != p.count:
+            raise SceneError(f"{file}: particles[{k}].positions: {len(p.positions)} given, count = {p.count}")
         _box(p.velocity, f"particles[{k}].velocity", file, 3)
     domain = _build(Domain, data["domain"], "domain", file)
     _box(domain.box, "domain.box", file)

@@ -1,0 +1,147 @@
+"""The LIGGGHTS input of a scene: every value taken from the scene, none typed twice.
+
+``place_particles(scene)`` puts each [[particles]] group in its region (explicit
+``positions`` or a jittered lattice, deterministic), ``write_data`` writes them as a
+LIGGGHTS data file, and ``input_lines`` gives the commands that build the DEM: granular SI
+setup, one atom type per material, the DEM's softened Hertz contact from each material's
+``dem`` table, box walls, gravity, integration. Per-type-pair values (restitution,
+friction) follow LIGGGHTS' rule of one value per pair of types: the mean of the two.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pyhost.scene import Scene, SceneError
+
+PLANES = {"xlo": ("xplane", 0), "xhi": ("xplane", 1), "ylo": ("yplane", 2), "yhi": ("yplane", 3),
+          "zlo": ("zplane", 4), "zhi": ("zplane", 5)}
+
+
+@dataclass(frozen=True)
+class Particles:
+    """Per-particle arrays (SI), ids 1..N in this order."""
+
+    position: np.ndarray        # (N, 3) [m]
+    velocity: np.ndarray        # (N, 3) [m/s]
+    radius: np.ndarray          # [m]
+    density: np.ndarray         # [kg/m^3]
+    temperature: np.ndarray     # [K]
+    material: np.ndarray        # index into scene.materials (atom type - 1)
+
+    @property
+    def mass(self):
+        return 4.0 / 3.0 * np.pi * self.radius**3 * self.density
+
+
+def num(x) -> str:
+    """A number as LIGGGHTS reads it, with every digit of the double."""
+    return f"{float(x):.17g}"
+
+
+def material_index(scene: Scene) -> dict:
+    return {name: k for k, name in enumerate(scene.materials)}
+
+
+def place_particles(scene: Scene, seed: int = 12345) -> Particles:
+    """Positions of every group: its explicit positions, else a jittered simple-cubic lattice
+    filling its region with spacing 2.1 radii (no initial overlaps)."""
+    rng = np.random.default_rng(seed)
+    index = material_index(scene)
+    parts = []
+    for k, g in enumerate(scene.particles):
+        if g.positions:
+            pos = np.asarray(g.positions, float)
+        else:
+            lo, hi = np.array(g.region[0::2], float), np.array(g.region[1::2], float)
+            spacing = 2.1 * g.radius
+            n = np.floor((hi - lo - 2 * g.radius) / spacing).astype(int) + 1
+            if np.any(n < 1) or n.prod() < g.count:
+                raise SceneError(f"{scene.path}: particles[{k}].region: holds {max(int(n.prod()), 0)} "
+                                 f"particles of radius {g.radius} m, not {g.count}")
+            cells = np.stack(np.meshgrid(*(np.arange(m) for m in n), indexing="ij"), -1).reshape(-1, 3)
+            cells = cells[np.argsort(cells[:, 2], kind="stable")][: g.count]   # fill from the bottom
+            jitter = rng.uniform(-0.04, 0.04, cells.shape) * g.radius
+            pos = lo + g.radius + cells * spacing + jitter
+        parts.append((pos, np.broadcast_to(np.asarray(g.velocity, float), pos.shape), g))
+    mats = scene.materials
+    return Particles(
+        position=np.concatenate([p for p, _, _ in parts]),
+        velocity=np.concatenate([v for _, v, _ in parts]),
+        radius=np.concatenate([np.full(len(p), g.radius) for p, _, g in parts]),
+        density=np.concatenate([np.full(len(p), mats[g.material].density) for p, _, g in parts]),
+        temperature=np.concatenate([np.full(len(p), g.temperature) for p, _, g in parts]),
+        material=np.concatenate([np.full(len(p), index[g.material]) for p, _, g in parts]),
+    )
+
+
+def write_data(path: Path, scene: Scene, particles: Particles) -> Path:
+    """A LIGGGHTS data file (atom_style granular: id type diameter density x y z)."""
+    box = scene.domain.box
+    lines = ["LIGGGHTS data file written by pyhost", "", f"{len(particles.radius)} atoms",
+             f"{len(scene.materials)} atom types", "",
+             f"{num(box[0])} {num(box[1])} xlo xhi", f"{num(box[2])} {num(box[3])} ylo yhi",
+             f"{num(box[4])} {num(box[5])} zlo zhi",
+             "", "Atoms", ""]
+    for k, (x, r, rho, m) in enumerate(zip(particles.position, particles.radius, particles.density,
+                                           particles.material), start=1):
+        lines.append(f"{k} {m + 1} {num(2 * r)} {num(rho)} {num(x[0])} {num(x[1])} {num(x[2])}")
+    lines += ["", "Velocities", ""]
+    for k, v in enumerate(particles.velocity, start=1):
+        lines.append(f"{k} {num(v[0])} {num(v[1])} {num(v[2])} 0 0 0")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def input_lines(scene: Scene, data_file: Path, skin: float | None = None) -> list[str]:
+    """LIGGGHTS commands that build the scene's DEM from its data file (nothing is run)."""
+    mats = list(scene.materials.values())
+    n = len(mats)
+    r_max = max(g.radius for g in scene.particles)
+    skin = 0.5 * r_max if skin is None else skin
+    periodic = " ".join("p" if p else "f" for p in scene.domain.periodic)
+    pairwise = lambda f: " ".join(num(0.5 * (f(a) + f(b))) for a in mats for b in mats)
+    g = np.asarray(scene.domain.gravity, float)
+    g_mag = float(np.linalg.norm(g))
+    lines = [
+        "atom_style granular", "atom_modify map array", f"boundary {periodic}", "newton off",
+        "communicate single vel yes", "units si",
+    ]
+    if any(m.dem.youngs_modulus > 1e9 for m in mats):
+        lines.append("hard_particles yes")
+    lines += [
+        f"read_data {data_file}",
+        f"neighbor {num(skin)} bin", "neigh_modify delay 0",
+        "fix m1 all property/global youngsModulus peratomtype " + " ".join(num(m.dem.youngs_modulus) for m in mats),
+        "fix m2 all property/global poissonsRatio peratomtype " + " ".join(num(m.dem.poisson_ratio) for m in mats),
+        f"fix m3 all property/global coefficientRestitution peratomtypepair {n} " + pairwise(lambda m: m.dem.restitution),
+        f"fix m4 all property/global coefficientFriction peratomtypepair {n} " + pairwise(lambda m: m.dem.friction),
+        "pair_style gran model hertz tangential history",
+        "pair_coeff * *",
+        f"timestep {num(scene.time.dem_step)}",
+    ]
+    if g_mag > 0:
+        lines.append(f"fix gravity all gravity {num(g_mag)} vector " + " ".join(num(c / g_mag) for c in g))
+    index = material_index(scene)
+    box = scene.domain.box
+    for k, w in enumerate(scene.walls):
+        kind, side = PLANES[w.plane]
+        lines.append(f"fix wall{k} all wall/gran model hertz tangential history primitive "
+                     f"type {index[w.material] + 1} {kind} {num(box[side])}")
+    lines += ["fix integrate all nve/sphere", "thermo_style custom step atoms ke", "thermo 100000"]
+    return lines
+
+
+def dem_collision_time(scene: Scene, v: float) -> float:
+    """Shortest Hertz collision time of the DEM among the scene's particles at impact speed
+    v [m/s] (eq. 32 with the DEM's softened modulus) [s]: the DEM step must resolve it."""
+    times = []
+    for grp in scene.particles:
+        m = scene.materials[grp.material]
+        E = m.dem.youngs_modulus / (2.0 * (1.0 - m.dem.poisson_ratio**2))
+        R, mass = grp.radius / 2.0, 4.0 / 3.0 * math.pi * grp.radius**3 * m.density / 2.0
+        times.append(2.8683 * (mass**2 / (E**2 * R * v)) ** 0.2)
+    return min(times)
