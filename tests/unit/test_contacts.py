@@ -1,0 +1,49 @@
+"""Contacts from geometry: overlaps, normals, approach speeds, periodic images, walls."""
+import numpy as np
+import pytest
+
+from pyhost.collisions import WALL_BASE
+from pyhost.contacts import find_contacts
+
+BOX = (0.0, 1.0, 0.0, 1.0, 0.0, 1.0)
+
+
+def test_pair_overlap_normal_and_approach():
+    x = np.array([[0.5, 0.5, 0.5], [0.65, 0.5, 0.5], [0.9, 0.9, 0.9]])
+    v = np.array([[1.0, 0, 0], [-1.0, 0, 0], [0, 0, 0]])
+    c = find_contacts(x, v, np.full(3, 0.1), BOX)
+    assert len(c) == 1 and {c.i[0], c.j[0]} == {0, 1}
+    assert c.delta[0] == pytest.approx(0.05)
+    assert c.approach[0] == pytest.approx(2.0)
+    assert np.allclose(c.normal[0], (x[c.i[0]] - x[c.j[0]]) / 0.15)
+
+
+def test_periodic_image_is_found():
+    x = np.array([[0.02, 0.5, 0.5], [0.97, 0.5, 0.5]])
+    c = find_contacts(x, np.zeros((2, 3)), np.full(2, 0.03), BOX, periodic=(True, False, False))
+    assert len(c) == 1 and c.delta[0] == pytest.approx(0.01)
+    assert np.allclose(np.abs(c.normal[0]), [1, 0, 0])
+    assert len(find_contacts(x, np.zeros((2, 3)), np.full(2, 0.03), BOX)) == 0
+
+
+def test_walls():
+    x = np.array([[0.5, 0.5, 0.05], [0.5, 0.5, 0.5], [0.97, 0.5, 0.5]])
+    v = np.array([[0, 0, -2.0], [0, 0, 0], [0.5, 0, 0]])
+    c = find_contacts(x, v, np.full(3, 0.1), BOX, walls=("zlo", "xhi"))
+    rows = sorted(zip(c.i.tolist(), c.j.tolist()))
+    assert rows == [(0, WALL_BASE), (2, WALL_BASE + 1)]
+    k = list(c.i).index(0)
+    assert c.delta[k] == pytest.approx(0.05) and c.approach[k] == pytest.approx(2.0)
+    assert np.allclose(c.normal[k], [0, 0, 1])
+    k = list(c.i).index(2)
+    assert c.approach[k] == pytest.approx(0.5) and np.allclose(c.normal[k], [-1, 0, 0])
+
+
+def test_agrees_with_brute_force():
+    rng = np.random.default_rng(7)
+    x = rng.uniform(size=(300, 3))
+    r = rng.uniform(0.01, 0.04, 300)
+    c = find_contacts(x, np.zeros_like(x), r, BOX)
+    d = np.linalg.norm(x[:, None] - x[None], axis=-1)
+    overlap = (r[:, None] + r[None] - d > 0) & ~np.eye(300, dtype=bool)
+    assert len(c) == overlap.sum() // 2
