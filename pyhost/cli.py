@@ -11,7 +11,7 @@ import importlib
 import re
 import sys
 
-COMMANDS = ("collide", "demo", "fit")
+COMMANDS = ("collide", "demo", "fit", "paper")
 
 
 class UserError(Exception):
