@@ -270,6 +270,8 @@ def load_scene(path) -> Scene:
     if time.dem_step >= time.end:
         raise SceneError(f"{file}: time.dem_step: must be below time.end ({time.end}), got {time.dem_step}")
     fluid = _build(Fluid, data["fluid"], "fluid", file) if "fluid" in data else None
+    if effects.restitution_feedback and effects.contact_heat == "none":
+        raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model in effects.contact_heat")
     if effects.fluid and fluid is None:
         raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
     output = _build(Output, data.get("output", {}), "output", file)
