@@ -45,13 +45,15 @@ def _cache_dir() -> Path:
 class Table:
     """Cubic tables of the dimensionless outputs of one model against v0/v_y."""
 
-    def __init__(self, model: str, b1: float, b2: float, c: float):
+    def __init__(self, model: str, b1: float, b2: float, c: float, spacing: float | None = None):
+        """``spacing``: node spacing in q (default H for A and C, H_SMOOTH for B); for
+        studies of table resolution (tools/bench_accuracy.py)."""
         self.model, self.b1, self.b2, self.c = model, b1, b2, c
         law = compression_law(get_model(model).compression, b1, b2, c)
         self.u_min, self.u_max = math.log(V_MIN), math.log(V_MAX)
         self.staged = hasattr(law, "v_hat_p")
         if self.staged:
-            h = H
+            h = H if spacing is None else spacing
             self.u_p = math.log(law.v_hat_p)
             n_ep = max(4, math.ceil(math.sqrt(self.u_p) / h))
             h = math.sqrt(self.u_p) / n_ep
@@ -61,7 +63,7 @@ class Table:
             segments = [np.arange(-n_el, 1) * h, np.arange(0, n_ep + 1) * h,
                         (n_ep + np.arange(0, n_fp + 1)) * h]
         else:
-            h = H_SMOOTH
+            h = H_SMOOTH if spacing is None else spacing
             n = math.ceil((self.u_max - self.u_min) / h)
             segments = [self.u_min + np.arange(0, n + 1) * h]
         self.h, self.q0 = h, segments[0][0]
@@ -117,13 +119,16 @@ class Table:
 
 
 @lru_cache(maxsize=32)
-def table(model: str, b1: float, b2: float, c: float) -> Table:
+def table(model: str, b1: float, b2: float, c: float, spacing: float | None = None) -> Table:
     """The table of ``model`` for (b1, b2, c): from memory, else from the disk cache
     (COLLHEAT_CACHE, default ~/.cache/collheat), else built (a few seconds) and cached.
-    The cache key holds the plugin's source, so a changed model never reads an old table."""
+    The cache key holds the plugin's source, so a changed model never reads an old table.
+    ``spacing`` other than None (the default H / H_SMOOTH) builds a table of that node
+    spacing, cached under its own key."""
     sources = b"".join((Path(__file__).parent / f).read_bytes()
                        for f in ("compression.py", "recovery.py", "exact.py", "fast.py"))
-    key = hashlib.sha256(repr((model, b1, b2, c)).encode() + sources).hexdigest()[:16]
+    ident = (model, b1, b2, c) if spacing is None else (model, b1, b2, c, float(spacing))
+    key = hashlib.sha256(repr(ident).encode() + sources).hexdigest()[:16]
     path = _cache_dir() / f"table-{model}-{key}.npy"
     tab = Table.__new__(Table)
     try:
@@ -132,7 +137,7 @@ def table(model: str, b1: float, b2: float, c: float) -> Table:
         return tab
     except (OSError, ValueError, EOFError):
         pass
-    tab = Table(model, b1, b2, c)
+    tab = Table(model, b1, b2, c, spacing)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(f".tmp{os.getpid()}.npy")
