@@ -147,6 +147,7 @@ class Time:
     end: float = spec(">0", doc="simulated time [s]")
     sample_every: int = spec(">0", 1, "DEM steps between contact samples")
     couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
+    test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,63 @@
+"""The small cases, run for real (LIGGGHTS in process): results against the plugin alone."""
+import csv
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import pyvista
+
+from plugins.heat import Pair, collide
+from pyhost.contact_heat import pair_properties
+from pyhost.scene import load_scene
+
+pytestmark = pytest.mark.engines
+CASES = Path(__file__).resolve().parents[2] / "cases"
+
+
+def run_case(name, out, *extra):
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(CASES / name), "--out", str(out), *extra],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    rows = list(csv.DictReader(open(out / "collisions.csv")))
+    return rows, json.loads((out / "summary.json").read_text())
+
+
+def last_frame(out):
+    reader = pyvista.get_reader(str(out / "vtk" / "particles.pvd"))
+    reader.set_active_time_value(reader.time_values[-1])
+    return reader.read()[0]
+
+
+def test_two_particles_match_plugin(tmp_path):
+    rows, summary = run_case("two-particles", tmp_path)
+    assert summary["collisions"] == 1 and summary["energy_balance_error"] == pytest.approx(0, abs=1e-12)
+    scene = load_scene(CASES / "two-particles" / "case.toml")
+    steel = scene.materials["steel"]
+    ref = collide(0.4, Pair(R1=2e-3, R2=2e-3, dT=100.0, **pair_properties(steel, steel)), "A")
+    row = rows[0]
+    assert float(row["v0"]) == pytest.approx(0.4, rel=1e-3)
+    for key, value in (("Q", ref.Q), ("e", ref.e), ("t_coll", ref.t_coll)):
+        assert float(row[key]) == pytest.approx(value, rel=0.01), key
+    v = last_frame(tmp_path).point_data["velocity"]
+    assert v[1, 0] - v[0, 0] == pytest.approx(ref.e * 0.4, rel=0.01)      # rebound with the model's e
+    T = last_frame(tmp_path).point_data["temperature"]
+    C = 4 / 3 * math.pi * 2e-3**3 * 7800 * 470
+    assert (400 - T[0]) * C == pytest.approx(ref.Q, rel=0.01)
+
+
+def test_wall_impact_matches_plugin_and_balances(tmp_path):
+    rows, summary = run_case("wall-impact", tmp_path)
+    scene = load_scene(CASES / "wall-impact" / "case.toml")
+    steel = scene.materials["steel"]
+    wall_row = [r for r in rows if r["wall"] != "0"][0]
+    v0 = float(wall_row["v0"])
+    assert v0 == pytest.approx(1.0, rel=1e-3)
+    ref = collide(v0, Pair.wall(dT=350.0 - 300.0, **pair_properties(steel, steel)), "B")
+    assert float(wall_row["Q"]) == pytest.approx(ref.Q, rel=0.01)
+    # the particle's heat content changed by exactly what came from the wall
+    assert summary["heat_from_walls"] == pytest.approx(-ref.Q, rel=0.01)
+    assert summary["energy_balance_error"] == pytest.approx(0, abs=1e-12)
