@@ -1,0 +1,71 @@
+// What LIGGGHTS 3.8's C library interface lacks, for pyhost/liggghts.py:
+// the size of a local compute (its row count is not in the C API), the force array of a
+// `fix external pf/array`, and a report of LIGGGHTS' last error when it ends the process.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mpi.h>
+#include "lammps.h"
+#include "modify.h"
+#include "compute.h"
+#include "fix_external.h"
+#include "update.h"
+
+using namespace LAMMPS_NS;
+
+static char exit_log[4096] = "";
+
+// On exit(1) from Error::all/one, print LIGGGHTS' ERROR line to stderr: the screen output
+// goes to a log file, so without this the process would end without a word.
+static void report_exit()
+{
+    if (!exit_log[0]) return;
+    FILE *f = std::fopen(exit_log, "r");
+    if (!f) return;
+    char line[4096], last[4096] = "";
+    while (std::fgets(line, sizeof line, f))
+        if (std::strncmp(line, "ERROR", 5) == 0) std::strcpy(last, line);
+    std::fclose(f);
+    if (last[0]) std::fprintf(stderr, "LIGGGHTS ended the process: %s(log: %s)\n", last, exit_log);
+}
+
+extern "C" {
+
+void collheat_watch_exit(const char *logfile)
+{
+    static bool registered = false;
+    std::snprintf(exit_log, sizeof exit_log, "%s", logfile ? logfile : "");
+    if (!registered) { std::atexit(report_exit); registered = true; }
+}
+
+// Rows and columns of a local compute, evaluated on the current step; its data pointer.
+// Returns 0, or -1 when there is no compute of that name or it produces no local data.
+int collheat_compute_local(void *ptr, const char *id, int *rows, int *cols, double **data)
+{
+    LAMMPS *lmp = static_cast<LAMMPS *>(ptr);
+    int i = lmp->modify->find_compute(id);
+    if (i < 0) return -1;
+    Compute *c = lmp->modify->compute[i];
+    if (!c->local_flag) return -1;
+    if (c->invoked_local != lmp->update->ntimestep) {
+        c->invoked_local = lmp->update->ntimestep;
+        c->compute_local();
+    }
+    *rows = c->size_local_rows;
+    *cols = c->size_local_cols;
+    if (data) *data = c->size_local_cols ? (c->size_local_rows ? c->array_local[0] : nullptr)
+                                         : c->vector_local;
+    return 0;
+}
+
+// The per-atom force array (nlocal x 3, contiguous) of a `fix external pf/array`, or null.
+double *collheat_fix_external_force(void *ptr, const char *id)
+{
+    LAMMPS *lmp = static_cast<LAMMPS *>(ptr);
+    int i = lmp->modify->find_fix(id);
+    if (i < 0 || std::strcmp(lmp->modify->fix[i]->style, "external") != 0) return nullptr;
+    FixExternal *f = static_cast<FixExternal *>(lmp->modify->fix[i]);
+    return f->fexternal ? f->fexternal[0] : nullptr;
+}
+
+}

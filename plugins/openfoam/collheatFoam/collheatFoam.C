@@ -1,0 +1,65 @@
+/*---------------------------------------------------------------------------*\
+Application
+    collheatFoam
+
+Description
+    Volume-averaged incompressible gas phase of a CFD-DEM simulation (OpenFOAM v1912),
+    after DPMFoam's equations, in the "model A" form (pressure and gravity shared by the
+    fluid fraction):
+
+        d(alpha)/dt + div(alpha U) = 0
+        d(alpha U)/dt + div(alpha U U) - div(alpha nu_eff grad U)
+            = -alpha grad(p) + alpha g + (Ksl/rho) (Us - U) + fvOptions
+
+    p is the kinematic pressure (Pa per rho), alpha the fluid volume fraction, Ksl the
+    particle-fluid momentum exchange coefficient per cell (kg/m^3/s, implicit in U), Us the
+    exchange-weighted particle velocity per cell (m/s). fp = Ksl (Us - U) is the interphase
+    force per unit volume that the particles exert on the fluid (N/m^3; f_p in Kosinski et
+    al. 2014), written with the other fields. PIMPLE/PISO set by system/fvSolution.
+
+    Without -link it runs as a plain solver with alpha, Ksl, Us read from the start time
+    (defaults 1, 0, 0). With -link DIR it serves a Python host (pyhost/openfoam.py) through
+    two named pipes per rank, DIR/rank<N>.in and DIR/rank<N>.out; see hostLink.H.
+\*---------------------------------------------------------------------------*/
+
+#include "fvCFD.H"
+#include "singlePhaseTransportModel.H"
+#include "PhaseIncompressibleTurbulenceModel.H"
+#include "pimpleControl.H"
+#include "fvOptions.H"
+#include "interpolation.H"
+#include <cstdio>
+
+int main(int argc, char *argv[])
+{
+    argList::addNote
+    (
+        "Volume-averaged incompressible fluid of a CFD-DEM simulation,"
+        " coupled to a Python host through named pipes (-link)."
+    );
+    argList::addOption("link", "dir", "serve the Python host through pipes in dir");
+
+    #include "setRootCaseLists.H"
+    #include "createTime.H"
+    #include "createMesh.H"
+    #include "createControl.H"
+    #include "createFields.H"
+    #include "createFvOptions.H"
+
+    if (args.found("link"))
+    {
+        #include "hostLink.H"
+    }
+    else
+    {
+        Info<< "\nStarting time loop\n" << endl;
+        while (runTime.run())
+        {
+            ++runTime;
+            #include "fluidStep.H"
+        }
+    }
+
+    Info<< "End\n" << endl;
+    return 0;
+}
