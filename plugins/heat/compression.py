@@ -165,6 +165,8 @@ class Stronge:
         if v <= self.v_hat_p:
             target = 0.4 * (v - 1.0) * (v + 1.0)
             f = lambda L: float(self.work_drop(1.0 + L, L)) - target
+            if f(self.x_p - 1.0) <= 0.0:      # v within rounding of v_p
+                return self.x_p
             L = brentq(f, 0.0, self.x_p - 1.0, xtol=1e-300, rtol=1e-15, maxiter=200)
             return 1.0 + L
         X = math.sqrt(self.X_p**2 + 4.0 * (0.4 * v * v - self.W_p) / self.beta)

@@ -25,6 +25,15 @@ def test_fully_plastic_onset_reached_at_delta_p(paper_pair):
     assert 1.05 < v_p < 1.15
 
 
+def test_onset_speeds_exactly(paper_pair):
+    # a speed of exactly v_y or v_p (as computed) lands on the regime boundary
+    v_y, v_p = paper_pair.onset_speeds()
+    for model in ("A", "B", "C"):
+        assert collide(v_y, paper_pair, model).delta_max == pytest.approx(paper_pair.delta_y, rel=1e-12) \
+            or model == "B"
+        assert collide(v_p, paper_pair, model).e > 0
+
+
 def test_recovery_ratios_tend_to_b1_over_b2(paper_pair):
     # eqs. (41)-(42): r2 = delta_r,S/delta_r,J and r3 = R_bar,J/R_bar,S -> b1/b2 = 0.393
     A, B = collide(1e3, paper_pair, "A"), collide(1e3, paper_pair, "B")
