@@ -38,6 +38,14 @@ void collheat_watch_exit(const char *logfile)
     if (!registered) { std::atexit(report_exit); registered = true; }
 }
 
+// Flush LIGGGHTS' screen output, so that a forked copy does not write it a second time.
+void collheat_flush(void *ptr)
+{
+    LAMMPS *lmp = static_cast<LAMMPS *>(ptr);
+    if (lmp->screen) std::fflush(lmp->screen);
+    if (lmp->logfile) std::fflush(lmp->logfile);
+}
+
 // Rows and columns of a local compute, evaluated on the current step; its data pointer.
 // Returns 0, or -1 when there is no compute of that name or it produces no local data.
 int collheat_compute_local(void *ptr, const char *id, int *rows, int *cols, double **data)

@@ -1,0 +1,302 @@
+"""LIGGGHTS 3.8 (Debian's ``libliggghts.so.3``) driven in process through ctypes.
+
+One ctypes declaration per C function (``_declare``); per-atom data as zero-copy numpy
+views of LIGGGHTS' own arrays, valid until the next command or run (take them again after
+each :meth:`Liggghts.run`); contact lists of ``compute pair/gran/local`` and
+``compute wall/gran/local`` read through the project's helper library
+(``plugins/liggghts``, built by ``tools/setup.sh --engines``), which also exposes the force
+array of a ``fix external pf/array`` for per-atom forces set from Python.
+
+LIGGGHTS ends its process on any error (``exit(1)``). So every command, input file and the
+first run after a change is tried first in a forked copy of this process: when the copy
+dies, :class:`LiggghtsError` carries LIGGGHTS' own ``ERROR`` line and this process goes on
+unharmed. Later run chunks are not tried (a fork costs milliseconds, a chunk microseconds);
+if one of them fails, the helper prints LIGGGHTS' message to stderr before the process
+ends. Units are whatever the input sets; the project uses ``units si`` (m, kg, s, K, N).
+"""
+from __future__ import annotations
+
+import ctypes
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+
+LIB = "libliggghts.so.3"
+HELPER = Path(__file__).resolve().parents[1] / ".setup" / "lib" / "libcollheat_liggghts.so"
+
+_c = ctypes
+_vp, _cp, _int = _c.c_void_p, _c.c_char_p, _c.c_int
+_DECLARATIONS = {
+    # name: (restype, argtypes) -- the 2013 LAMMPS C API that LIGGGHTS 3.8 exports
+    "lammps_open_no_mpi": (None, [_int, _c.POINTER(_cp), _c.POINTER(_vp)]),
+    "lammps_close": (None, [_vp]),
+    "lammps_file": (None, [_vp, _cp]),
+    "lammps_command": (_cp, [_vp, _cp]),
+    "lammps_extract_global": (_vp, [_vp, _cp]),
+    "lammps_extract_atom": (_vp, [_vp, _cp]),
+    "lammps_extract_compute": (_vp, [_vp, _cp, _int, _int]),
+    "lammps_extract_fix": (_vp, [_vp, _cp, _int, _int, _int, _int]),
+    "lammps_get_natoms": (_int, [_vp]),
+}
+_HELPER_DECLARATIONS = {
+    "collheat_watch_exit": (None, [_cp]),
+    "collheat_flush": (None, [_vp]),
+    "collheat_compute_local": (_int, [_vp, _cp, _c.POINTER(_int), _c.POINTER(_int),
+                                      _c.POINTER(_c.POINTER(_c.c_double))]),
+    "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
+}
+
+# Per-atom arrays: name -> (ctype, columns; 0 for a vector).
+_ATOM = {
+    "x": (_c.c_double, 3), "v": (_c.c_double, 3), "f": (_c.c_double, 3),
+    "omega": (_c.c_double, 3), "radius": (_c.c_double, 0), "rmass": (_c.c_double, 0),
+    "id": (_c.c_int, 0), "type": (_c.c_int, 0),
+}
+
+
+class LiggghtsError(RuntimeError):
+    """A LIGGGHTS error, with LIGGGHTS' own message."""
+
+
+def _declare(lib: ctypes.CDLL, table: dict) -> None:
+    for name, (restype, argtypes) in table.items():
+        fn = getattr(lib, name)
+        fn.restype, fn.argtypes = restype, argtypes
+
+
+@dataclass(frozen=True)
+class Contacts:
+    """Contacts overlapping now, one row each (all SI).
+
+    ``i``, ``j``: atom ids (``j`` is 0 for a wall contact); ``delta``: normal overlap (m);
+    ``vi``, ``vj``: velocities of the two (m/s; ``vj`` zero for a wall), so the relative
+    velocity is ``vi - vj``; ``area``: contact area (m^2) as LIGGGHTS computes it.
+    """
+
+    i: np.ndarray
+    j: np.ndarray
+    delta: np.ndarray
+    vi: np.ndarray
+    vj: np.ndarray
+    area: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.i)
+
+
+# compute pair/gran/local with these columns, in LIGGGHTS' own column order:
+# vel (6), id (3: i, j, periodic), contactArea (1), delta (1).
+_PAIR_KEYWORDS = "vel id contactArea delta"
+_WALL_KEYWORDS = _PAIR_KEYWORDS
+
+
+class Liggghts:
+    """One LIGGGHTS instance in this process (serial, no MPI communicator of ours).
+
+    ``workdir``: where LIGGGHTS writes its screen log (``log.liggghts``); a temporary
+    directory if None. ``check``: try commands in a forked copy first (see the module doc).
+    """
+
+    def __init__(self, workdir: str | os.PathLike | None = None, *, check: bool = True):
+        # A forked copy must be able to call MPI_Finalize without the parent's MPI server.
+        os.environ.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
+        os.environ.setdefault("OMPI_MCA_btl", "self")
+        if not HELPER.is_file():
+            raise LiggghtsError(f"{HELPER} is missing: run tools/setup.sh --engines")
+        self._tmp = None if workdir else tempfile.TemporaryDirectory(prefix="liggghts-")
+        self.workdir = Path(workdir or self._tmp.name)
+        self.workdir.mkdir(parents=True, exist_ok=True)
+        self.log = self.workdir / "log.liggghts"
+        self.check = check
+        self.lib = ctypes.CDLL(LIB, mode=ctypes.RTLD_GLOBAL)
+        self.helper = ctypes.CDLL(str(HELPER), mode=ctypes.RTLD_GLOBAL)
+        _declare(self.lib, _DECLARATIONS)
+        _declare(self.helper, _HELPER_DECLARATIONS)
+        args = [b"liggghts", b"-screen", str(self.log).encode(), b"-log", b"none"]
+        argv = (_cp * len(args))(*args)
+        self.ptr = _vp()
+        self.lib.lammps_open_no_mpi(len(args), argv, ctypes.byref(self.ptr))
+        self.helper.collheat_watch_exit(str(self.log).encode())
+        self._changed = True  # a command since the last run: try the next run first
+
+    # -- commands ---------------------------------------------------------------------
+    def command(self, line: str) -> None:
+        """Execute one LIGGGHTS command; raise LiggghtsError with LIGGGHTS' message."""
+        if line.split()[:1] == ["include"]:
+            raise LiggghtsError("'include' does nothing through the C API: use Liggghts.file()")
+        self._tried(lambda: self.lib.lammps_command(self.ptr, line.encode()), line)
+        self.lib.lammps_command(self.ptr, line.encode())
+        self._changed = True
+
+    def commands(self, lines: Iterable[str] | str) -> None:
+        """Execute several commands (an iterable, or a string of lines; '#' starts a comment)."""
+        if isinstance(lines, str):
+            lines = lines.splitlines()
+        for line in lines:
+            line = line.split("#", 1)[0].strip()
+            if line:
+                self.command(line)
+
+    def file(self, path: str | os.PathLike) -> None:
+        """Execute an input file (what ``include`` would do)."""
+        path = Path(path)
+        if not path.is_file():
+            raise LiggghtsError(f"LIGGGHTS input {path} does not exist")
+        self._tried(lambda: self.lib.lammps_file(self.ptr, str(path).encode()), f"file {path}")
+        self.lib.lammps_file(self.ptr, str(path).encode())
+        self._changed = True
+
+    def run(self, steps: int) -> None:
+        """Advance ``steps`` time steps as one chunk (``run N pre no post no``); the first run
+        after any command does a full set-up (``pre yes``) and is tried first."""
+        if steps < 0:
+            raise ValueError(f"steps must be >= 0, got {steps}")
+        line = f"run {steps} post no" if self._changed else f"run {steps} pre no post no"
+        if self._changed:
+            self._tried(lambda: self.lib.lammps_command(self.ptr, line.encode()), line)
+        self.lib.lammps_command(self.ptr, line.encode())
+        self._changed = False
+
+    def _tried(self, call, what: str) -> None:
+        """Run ``call`` in a forked copy of this process; raise if LIGGGHTS ended it."""
+        if not self.check:
+            return
+        self.helper.collheat_flush(self.ptr)
+        start = self.log.stat().st_size if self.log.exists() else 0
+        pid = os.fork()
+        if pid == 0:  # the copy: never returns into Python's normal flow
+            try:
+                self.helper.collheat_watch_exit(b"")  # the parent reports, not the copy
+                call()
+                self.helper.collheat_flush(self.ptr)
+            finally:
+                os._exit(0)
+        _, status = os.waitpid(pid, 0)
+        if os.waitstatus_to_exitcode(status) != 0:
+            with open(self.log, "rb") as f:
+                f.seek(start)
+                text = f.read().decode(errors="replace")
+            # The copy's output is not this process's: cut it from the log again.
+            os.truncate(self.log, start)
+            errors = [ln for ln in text.splitlines() if ln.startswith("ERROR")]
+            message = errors[-1] if errors else (text.strip().splitlines() or ["no message"])[-1]
+            raise LiggghtsError(f"LIGGGHTS refused '{what}': {message}")
+        os.truncate(self.log, start)
+
+    # -- per-atom data ----------------------------------------------------------------
+    @property
+    def nlocal(self) -> int:
+        """Number of atoms owned by this process."""
+        return ctypes.cast(self.lib.lammps_extract_global(self.ptr, b"nlocal"),
+                           ctypes.POINTER(_int))[0]
+
+    @property
+    def natoms(self) -> int:
+        return self.lib.lammps_get_natoms(self.ptr)
+
+    @property
+    def step(self) -> int:
+        """Current time step number."""
+        raw = self.lib.lammps_extract_global(self.ptr, b"ntimestep")
+        return ctypes.cast(raw, ctypes.POINTER(ctypes.c_int64))[0]
+
+    @property
+    def dt(self) -> float:
+        """Time step (s)."""
+        return ctypes.cast(self.lib.lammps_extract_global(self.ptr, b"dt"),
+                           ctypes.POINTER(ctypes.c_double))[0]
+
+    def atom(self, name: str) -> np.ndarray:
+        """Zero-copy view of a per-atom array of the local atoms, in LIGGGHTS' local order:
+        x, v, f, omega (n, 3); radius, rmass, id, type (n,). Valid until the next run."""
+        if name not in _ATOM:
+            raise ValueError(f"unknown per-atom array '{name}'; choices: {', '.join(_ATOM)}")
+        ctype, cols = _ATOM[name]
+        raw = self.lib.lammps_extract_atom(self.ptr, name.encode())
+        n = self.nlocal
+        if not raw or n == 0:
+            return np.zeros((0, cols) if cols else (0,), dtype=np.dtype(ctype))
+        if cols:
+            first = ctypes.cast(raw, ctypes.POINTER(ctypes.POINTER(ctype)))[0]
+            return np.ctypeslib.as_array(first, shape=(n, cols))
+        return np.ctypeslib.as_array(ctypes.cast(raw, ctypes.POINTER(ctype)), shape=(n,))
+
+    def property_atom(self, name: str) -> np.ndarray:
+        """Zero-copy view of the per-atom scalar of a ``fix property/atom`` named ``name``
+        (for ``fix heat/gran``: ``Temp`` in K, ``heatFlux`` in W). Writes into it are seen by
+        the next run; values written before the first run are reset by it."""
+        raw = self.lib.lammps_extract_fix(self.ptr, name.encode(), 1, 1, 0, 0)
+        if not raw:
+            raise LiggghtsError(f"no per-atom property '{name}' (a fix property/atom with that id)")
+        return np.ctypeslib.as_array(ctypes.cast(raw, ctypes.POINTER(ctypes.c_double)),
+                                     shape=(self.nlocal,))
+
+    def temperature(self) -> np.ndarray:
+        """Particle temperatures (K) of ``fix heat/gran``: a writable zero-copy view."""
+        return self.property_atom("Temp")
+
+    def external_force(self, fix_id: str) -> np.ndarray:
+        """Writable zero-copy (n, 3) view of the force (N) that ``fix <fix_id> all external
+        pf/array 1`` adds to each local atom every step."""
+        raw = self.helper.collheat_fix_external_force(self.ptr, fix_id.encode())
+        if not raw:
+            raise LiggghtsError(f"no 'fix {fix_id} ... external pf/array' (or no run yet)")
+        return np.ctypeslib.as_array(raw, shape=(self.nlocal, 3))
+
+    # -- contacts ---------------------------------------------------------------------
+    def add_pair_contacts(self, compute_id: str = "pairs") -> None:
+        """Define the pair-contact compute read by :meth:`pair_contacts` (once per pair
+        style, before the first run)."""
+        self.command(f"compute {compute_id} all pair/gran/local {_PAIR_KEYWORDS}")
+
+    def add_wall_contacts(self, compute_id: str = "walls", wall_fix: str | None = None) -> None:
+        """Define the wall-contact compute read by :meth:`wall_contacts`. Mesh walls need no
+        ``wall_fix``; primitive walls need ``store_force yes`` on their ``fix wall/gran``."""
+        extra = f" wall {wall_fix}" if wall_fix else ""
+        self.command(f"compute {compute_id} all wall/gran/local {_WALL_KEYWORDS}{extra}")
+
+    def local_array(self, compute_id: str) -> np.ndarray:
+        """A local compute's rows on the current step, as a (rows, cols) copy."""
+        rows, cols, data = _int(), _int(), ctypes.POINTER(ctypes.c_double)()
+        if self.helper.collheat_compute_local(self.ptr, compute_id.encode(), ctypes.byref(rows),
+                                              ctypes.byref(cols), ctypes.byref(data)) != 0:
+            raise LiggghtsError(f"no local compute '{compute_id}'")
+        shape = (rows.value, max(cols.value, 1))
+        if rows.value == 0:
+            return np.zeros(shape)
+        return np.ctypeslib.as_array(data, shape=shape).copy()
+
+    def pair_contacts(self, compute_id: str = "pairs") -> Contacts:
+        """Particle-particle contacts now (see :class:`Contacts`)."""
+        return self._contacts(self.local_array(compute_id))
+
+    def wall_contacts(self, compute_id: str = "walls") -> Contacts:
+        """Particle-wall contacts now; ``j`` is 0 and ``vj`` the wall's velocity (0 for a
+        fixed wall)."""
+        return self._contacts(self.local_array(compute_id))
+
+    @staticmethod
+    def _contacts(a: np.ndarray) -> Contacts:
+        if a.shape[1] != 11:
+            raise LiggghtsError(f"contact compute has {a.shape[1]} columns, expected 11: "
+                                "define it with add_pair_contacts()/add_wall_contacts()")
+        return Contacts(i=a[:, 6].astype(np.int64), j=a[:, 7].astype(np.int64),
+                        delta=a[:, 10], vi=a[:, 0:3], vj=a[:, 3:6], area=a[:, 9])
+
+    def close(self) -> None:
+        if self.ptr:
+            self.lib.lammps_close(self.ptr)
+            self.ptr = _vp()
+        if self._tmp is not None:
+            self._tmp.cleanup()
+            self._tmp = None
+
+    def __enter__(self) -> "Liggghts":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

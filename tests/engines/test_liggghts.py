@@ -1,0 +1,105 @@
+"""LIGGGHTS bridge on the real engine: two 2 mm glass-like spheres meeting head-on."""
+import math
+import os
+
+import numpy as np
+import pytest
+
+from pyhost.liggghts import Liggghts, LiggghtsError
+
+pytestmark = pytest.mark.engines
+
+R, RHO, E, NU = 1e-3, 2500.0, 5e6, 0.3          # m, kg/m^3, Pa, -
+K, C = 1.0, 800.0                               # W/m/K, J/kg/K
+V, DT = 1.0, 1e-6                               # m/s each (head-on), s
+
+
+def two_spheres(workdir) -> Liggghts:
+    lg = Liggghts(workdir)
+    lg.commands(f"""
+        atom_style granular
+        atom_modify map array
+        boundary f f f
+        newton off
+        communicate single vel yes
+        units si
+        region box block -0.01 0.01 -0.01 0.01 -0.01 0.01 units box
+        create_box 1 box
+        neighbor {R / 2} bin
+        neigh_modify delay 0
+        fix m1 all property/global youngsModulus peratomtype {E}
+        fix m2 all property/global poissonsRatio peratomtype {NU}
+        fix m3 all property/global coefficientRestitution peratomtypepair 1 1.0
+        fix m4 all property/global coefficientFriction peratomtypepair 1 0.5
+        fix m5 all property/global thermalConductivity peratomtype {K}
+        fix m6 all property/global thermalCapacity peratomtype {C}
+        pair_style gran model hertz tangential history
+        pair_coeff * *
+        timestep {DT}
+        create_atoms 1 single {-1.5 * R} 0 0 units box
+        create_atoms 1 single {1.5 * R} 0 0 units box
+        set atom 1 diameter {2 * R} density {RHO} vx {V}
+        set atom 2 diameter {2 * R} density {RHO} vx {-V}
+        fix heat all heat/gran initial_temperature 300
+        fix integrate all nve/sphere
+    """)
+    lg.add_pair_contacts()
+    return lg
+
+
+def hertz_contact_time(v_rel: float) -> float:
+    """Duration (s) of an elastic Hertz impact of two equal spheres (Johnson 1985, eq. 11.24)."""
+    m_eff = 0.5 * RHO * 4 / 3 * math.pi * R**3
+    e_eff = E / (2 * (1 - NU**2))
+    return 2.8683 * (m_eff**2 / ((R / 2) * e_eff**2 * v_rel)) ** 0.2
+
+
+def test_contact_list_shows_the_pair_for_the_hertz_duration(tmp_path):
+    with two_spheres(tmp_path) as lg:
+        lg.run(0)
+        steps_in_contact, pairs = 0, set()
+        for _ in range(1500):
+            lg.run(1)
+            c = lg.pair_contacts()
+            steps_in_contact += len(c)
+            pairs |= {tuple(sorted(p)) for p in zip(c.i, c.j)}
+            if len(c):
+                assert np.allclose(c.vi - c.vj, lg.atom("v")[0] - lg.atom("v")[1])
+        expected = hertz_contact_time(2 * V) / DT
+        assert pairs == {(1, 2)}
+        # Hertz with e = 1; the count is a whole number of steps: 1 % plus one step.
+        assert abs(steps_in_contact - expected) <= 0.01 * expected + 1
+        # The spheres rebound with their speed (e = 1): momentum and energy kept to 1e-3.
+        assert np.allclose(lg.atom("v")[:, 0], [-V, V], rtol=1e-3)
+
+
+def test_temperatures_written_from_python_drive_the_next_steps(tmp_path):
+    with two_spheres(tmp_path) as lg:
+        lg.run(0)                 # values written before the first run are reset by it
+        lg.temperature()[:] = [400.0, 300.0]
+        m = RHO * 4 / 3 * math.pi * R**3
+        h_sum = 0.0               # sum over steps of h * (T1 - T2) * dt, from the contact list
+        for _ in range(1500):
+            t1, t2 = lg.temperature()
+            lg.run(1)
+            c = lg.pair_contacts()
+            if len(c):
+                # fix heat/gran: h = 4 k_i k_j / (k_i + k_j) sqrt(A) = 2 k sqrt(A), with A the
+                # contact area of the list (the lens of two equal spheres: pi (R delta - delta^2/4))
+                assert c.area[0] == pytest.approx(math.pi * (R * c.delta[0] - c.delta[0]**2 / 4), rel=1e-6)
+                h_sum += 2 * K * math.sqrt(c.area[0]) * (t1 - t2) * DT
+        t1, t2 = lg.temperature()
+        assert t1 + t2 == pytest.approx(700.0, abs=1e-9)     # heat is conserved
+        assert 400.0 - t1 > 1e-3                               # and some was conducted
+        assert (400.0 - t1) * m * C == pytest.approx(h_sum, rel=0.02)
+
+
+def test_bad_command_raises_with_liggghts_message_and_host_survives(tmp_path):
+    with two_spheres(tmp_path) as lg:
+        with pytest.raises(LiggghtsError, match='Invalid fix style: "bogus"'):
+            lg.command("fix f1 all bogus 1 2 3")
+        with pytest.raises(LiggghtsError, match="ERROR"):
+            lg.command("pair_coeff 7 7")
+        lg.run(10)                 # the instance is unharmed and still runs
+        assert lg.step == 10
+        assert os.getpid() > 0
