@@ -1,0 +1,117 @@
+"""Write a small OpenFOAM case for ``collheatFoam``: a box of uniform hexahedra.
+
+Files are written with foamlib; every value comes from the arguments (SI units). Each of
+the six faces (xlo, xhi, ylo, yhi, zlo, zhi) gets one boundary kind:
+
+- ``"wall"``: no-slip wall; ``"slip"``: frictionless wall (both: fixedFluxPressure);
+- ``("inlet", (ux, uy, uz))``: fixed velocity (m/s), fixedFluxPressure;
+- ``"outlet"``: fixed pressure 0, velocity zeroGradient (inletOutlet).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from foamlib import FoamFile
+
+FACES = {  # blockMesh vertex order of a hex: 0..3 bottom (z lo), 4..7 top
+    "xlo": (0, 4, 7, 3), "xhi": (1, 2, 6, 5), "ylo": (0, 1, 5, 4),
+    "yhi": (3, 7, 6, 2), "zlo": (0, 3, 2, 1), "zhi": (4, 5, 6, 7),
+}
+
+
+def _dict(path: Path, class_: str = "dictionary") -> FoamFile:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.unlink(missing_ok=True)
+    f = FoamFile(path)
+    f.class_ = class_
+    f.object_ = path.name
+    return f
+
+
+def _bc(kind, field: str) -> dict:
+    name, value = (kind if isinstance(kind, tuple) else (kind, None))
+    if name not in ("wall", "slip", "inlet", "outlet"):
+        raise ValueError(f"unknown boundary kind '{name}'; choices: wall, slip, inlet, outlet")
+    if field == "U":
+        return {"wall": {"type": "noSlip"}, "slip": {"type": "slip"},
+                "inlet": {"type": "fixedValue", "value": np.asarray(value, float)},
+                "outlet": {"type": "inletOutlet", "inletValue": np.zeros(3),
+                           "value": np.zeros(3)}}[name]
+    if name == "outlet":
+        return {"type": "fixedValue", "value": 0.0}
+    return {"type": "fixedFluxPressure", "value": 0.0}
+
+
+def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, nu: float,
+             gravity=(0.0, 0.0, -9.81), dt: float = 1e-3, nprocs: int = 1,
+             n_correctors: int = 2, n_outer: int = 1, max_speed: float = 1e3) -> Path:
+    """Write the case at ``path`` and return it. ``lo``, ``hi``: box corners (m);
+    ``cells``: cells per axis; ``boundaries``: kind per face (module doc); ``rho`` (kg/m^3),
+    ``nu`` (m^2/s): fluid; ``dt``: default time step (s); ``nprocs``: ranks of the
+    decomposeParDict (method simple, split along x); ``n_correctors``, ``n_outer``: PISO and
+    PIMPLE loops; ``max_speed``: speed (m/s) taken as divergence."""
+    path = Path(path)
+    missing = set(FACES) - set(boundaries)
+    if missing:
+        raise ValueError(f"boundaries: no kind given for {', '.join(sorted(missing))}")
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    corners = [[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
+               for k, j, i in [(0, 0, 0), (0, 0, 1), (0, 1, 1), (0, 1, 0),
+                               (1, 0, 0), (1, 0, 1), (1, 1, 1), (1, 1, 0)]]
+    mesh = _dict(path / "system" / "blockMeshDict")
+    mesh["convertToMeters"] = 1
+    mesh["vertices"] = np.array(corners)
+    mesh["blocks"] = ["hex", list(range(8)), list(map(int, cells)), "simpleGrading", [1, 1, 1]]
+    mesh["boundary"] = [(face, {"type": "wall" if boundaries[face] in ("wall", "slip") else "patch",
+                                "faces": [list(FACES[face])]}) for face in FACES]
+
+    control = _dict(path / "system" / "controlDict")
+    control.update({
+        "application": "collheatFoam", "startFrom": "startTime", "startTime": 0,
+        "stopAt": "endTime", "endTime": 1e9, "deltaT": dt, "writeControl": "timeStep",
+        "writeInterval": 10**9, "purgeWrite": 0, "writeFormat": "ascii", "writePrecision": 10,
+        "timePrecision": 10, "runTimeModifiable": False, "maxSpeed": max_speed,
+    })
+    schemes = _dict(path / "system" / "fvSchemes")
+    schemes.update({
+        "ddtSchemes": {"default": "Euler"},
+        "gradSchemes": {"default": ("Gauss", "linear")},
+        "divSchemes": {"default": "none", "div(alphaPhi,U)": ("Gauss", "limitedLinearV", 1),
+                       "div(((alpha*nuEff)*dev2(T(grad(U)))))": ("Gauss", "linear"),
+                       "div(phi,U)": ("Gauss", "limitedLinearV", 1)},
+        "laplacianSchemes": {"default": ("Gauss", "linear", "corrected")},
+        "interpolationSchemes": {"default": "linear"},
+        "snGradSchemes": {"default": "corrected"},
+    })
+    solution = _dict(path / "system" / "fvSolution")
+    solution.update({
+        "solvers": {
+            "p": {"solver": "GAMG", "smoother": "DIC", "tolerance": 1e-10, "relTol": 0.01},
+            "pFinal": {"solver": "GAMG", "smoother": "DIC", "tolerance": 1e-10, "relTol": 0},
+            '"(U|UFinal)"': {"solver": "smoothSolver", "smoother": "symGaussSeidel",
+                           "tolerance": 1e-10, "relTol": 0},
+        },
+        "PIMPLE": {"momentumPredictor": True, "nOuterCorrectors": n_outer,
+                   "nCorrectors": n_correctors, "nNonOrthogonalCorrectors": 0,
+                   "pRefCell": 0, "pRefValue": 0},
+    })
+    decompose = _dict(path / "system" / "decomposeParDict")
+    decompose.update({"numberOfSubdomains": nprocs, "method": "simple",
+                      "coeffs": {"n": [nprocs, 1, 1]}})
+
+    transport = _dict(path / "constant" / "transportProperties")
+    transport.update({"transportModel": "Newtonian", "nu": nu, "rho": rho})
+    turbulence = _dict(path / "constant" / "turbulenceProperties")
+    turbulence["simulationType"] = "laminar"
+    g = _dict(path / "constant" / "g", "uniformDimensionedVectorField")
+    g["dimensions"] = FoamFile.DimensionSet(length=1, time=-2)
+    g["value"] = np.asarray(gravity, float)
+
+    for field, cls, dims, zero in (("U", "volVectorField", dict(length=1, time=-1), np.zeros(3)),
+                                   ("p", "volScalarField", dict(length=2, time=-2), 0.0)):
+        f = _dict(path / "0" / field, cls)
+        f["dimensions"] = FoamFile.DimensionSet(**dims)
+        f["internalField"] = zero
+        f["boundaryField"] = {face: _bc(kind, field) for face, kind in boundaries.items()}
+    return path

@@ -1,0 +1,306 @@
+"""The fluid of a CFD-DEM run: the project's OpenFOAM solver ``collheatFoam`` kept running
+for a whole simulation and driven from Python.
+
+:class:`FluidSolver` starts the solver (serial, or ``mpirun -np N`` after ``decomposePar``),
+exchanges per-particle and per-cell data with each rank through two named pipes (see
+``plugins/openfoam/collheatFoam/hostLink.H``), and turns the fluid seen by each particle into
+a force with a drag law chosen by name (:mod:`pyhost.drag`). Every exchange is checked: a
+solver that diverges or stops raises :class:`FluidError` carrying the tail of its log.
+
+Units: SI throughout. The solver's pressure is kinematic (m^2/s^2); this module gives Pa.
+"""
+from __future__ import annotations
+
+import fcntl
+import os
+import select
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+from foamlib import FoamFile
+
+from pyhost import drag as drag_laws
+
+SOLVER = Path(__file__).resolve().parents[1] / ".setup" / "bin" / "collheatFoam"
+LOCATE, ADVANCE, FIELDS, WRITE, STOP = 1, 2, 3, 4, 5
+
+
+class FluidError(RuntimeError):
+    """The fluid solver failed; the message ends with the tail of its log."""
+
+
+def foam_env() -> dict:
+    """Environment for Debian's OpenFOAM v1912 binaries and OpenMPI as root."""
+    env = dict(os.environ)
+    env.setdefault("WM_PROJECT_DIR", "/usr/share/openfoam")
+    env.setdefault("USER", "root")
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    env.pop("OMPI_MCA_ess_singleton_isolated", None)  # set by pyhost.liggghts for its forks
+    return env
+
+
+def log_tail(log: Path, lines: int = 25) -> str:
+    try:
+        text = log.read_text(errors="replace").rstrip().splitlines()
+    except FileNotFoundError:
+        return f"(no log at {log})"
+    return "\n".join(text[-lines:])
+
+
+def run_utility(case: Path, *command: str) -> None:
+    """Run an OpenFOAM utility in ``case`` (log in ``case/log.<utility>``); FluidError on failure."""
+    log = Path(case) / f"log.{command[0]}"
+    with open(log, "w") as out:
+        rc = subprocess.run([*command, "-case", str(case)], stdout=out, stderr=subprocess.STDOUT,
+                            env=foam_env()).returncode
+    if rc != 0:
+        raise FluidError(f"{command[0]} failed in {case} (exit code {rc}); end of {log}:\n"
+                         f"{log_tail(log)}")
+
+
+class FluidSolver:
+    """``collheatFoam`` running on an OpenFOAM case, driven step by step.
+
+    ``case``: a case directory with a mesh (or a blockMeshDict), 0/U, 0/p and
+    constant/transportProperties giving ``nu`` (m^2/s) and ``rho`` (kg/m^3).
+    ``nprocs``: MPI ranks (>1 decomposes the case first; the case needs
+    system/decomposeParDict). ``drag``: name of a law in :mod:`pyhost.drag`.
+    ``alpha_min``: floor of the fluid volume fraction handed to the solver (-).
+    ``timeout``: seconds the host waits for one answer of the solver.
+
+    Use ``with FluidSolver(case) as fluid: ...`` or :meth:`start` / :meth:`stop`.
+    """
+
+    def __init__(self, case: str | os.PathLike, *, nprocs: int = 1, drag: str = "gidaspow",
+                 alpha_min: float = 0.3, timeout: float = 120.0):
+        self.case = Path(case).resolve()
+        if not (self.case / "system" / "controlDict").is_file():
+            raise FluidError(f"{self.case} is not an OpenFOAM case (no system/controlDict)")
+        if nprocs < 1:
+            raise ValueError(f"nprocs must be >= 1, got {nprocs}")
+        self.drag_law = drag_laws.get(drag)
+        self.drag = drag
+        self.nprocs, self.alpha_min, self.timeout = nprocs, alpha_min, timeout
+        props = FoamFile(self.case / "constant" / "transportProperties")
+        self.nu = _value(props["nu"])
+        self.rho = _value(props["rho"])
+        self.log = self.case / "log.collheatFoam"
+        self.proc: subprocess.Popen | None = None
+        self._fds: list[tuple[int, int]] = []
+        self.time = 0.0
+
+    # -- life cycle -------------------------------------------------------------------
+    def start(self) -> "FluidSolver":
+        """Mesh (blockMesh if needed), decompose if parallel, launch, and connect."""
+        if not SOLVER.is_file():
+            raise FluidError(f"{SOLVER} is missing: run tools/setup.sh --engines")
+        if not (self.case / "constant" / "polyMesh" / "owner").is_file():
+            run_utility(self.case, "blockMesh")
+        command = [str(SOLVER), "-case", str(self.case)]
+        if self.nprocs > 1:
+            for old in self.case.glob("processor*"):
+                shutil.rmtree(old)
+            run_utility(self.case, "decomposePar", "-force")
+            command = ["mpirun", "--oversubscribe", "-np", str(self.nprocs), *command, "-parallel"]
+        link = self.case / ".link"
+        shutil.rmtree(link, ignore_errors=True)
+        link.mkdir()
+        for rank in range(self.nprocs):
+            os.mkfifo(link / f"rank{rank}.in")
+            os.mkfifo(link / f"rank{rank}.out")
+        with open(self.log, "w") as out:
+            self.proc = subprocess.Popen([*command, "-link", str(link)], stdout=out,
+                                         stderr=subprocess.STDOUT, env=foam_env())
+        centres, volumes = [], []
+        for rank in range(self.nprocs):
+            fd_in = self._open_writer(link / f"rank{rank}.in")
+            fd_out = os.open(link / f"rank{rank}.out", os.O_RDONLY | os.O_NONBLOCK)
+            self._fds.append((fd_in, fd_out))
+            nc = int(self._read(rank, np.int32, 1)[0])
+            centres.append(self._read(rank, np.float64, 3 * nc).reshape(nc, 3))
+            volumes.append(self._read(rank, np.float64, nc))
+        self.rank_cells = np.array([len(v) for v in volumes])
+        self.offsets = np.concatenate([[0], np.cumsum(self.rank_cells)])
+        self.cell_centres = np.concatenate(centres)
+        self.cell_volumes = np.concatenate(volumes)
+        n = len(self.cell_volumes)
+        self._alpha, self._ksl, self._us = np.ones(n), np.zeros(n), np.zeros((n, 3))
+        return self
+
+    def stop(self) -> None:
+        """End the solver (it writes nothing more) and remove the pipes."""
+        if self.proc is None:
+            return
+        try:
+            if self.proc.poll() is None:
+                for rank in range(self.nprocs):
+                    self._send(rank, np.int32(STOP).tobytes())
+                for rank in range(self.nprocs):
+                    self._read(rank, np.float64, 1)
+                self.proc.wait(timeout=self.timeout)
+        finally:
+            for fds in self._fds:
+                for fd in fds:
+                    os.close(fd)
+            self._fds = []
+            if self.proc.poll() is None:
+                self.proc.kill()
+                self.proc.wait()
+            self.proc = None
+            shutil.rmtree(self.case / ".link", ignore_errors=True)
+
+    def __enter__(self) -> "FluidSolver":
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    # -- coupling ---------------------------------------------------------------------
+    def particle_forces(self, x: np.ndarray, v: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """Fluid force on each particle (N, shape (n, 3)) from the current fluid: drag
+        ``K (u - v)`` plus pressure gradient ``-V_p grad p``; also sets the per-cell fluid
+        fraction, exchange coefficient Ksl and particle velocity Us used by the next
+        :meth:`advance`. ``x`` positions (m), ``v`` velocities (m/s), ``d`` diameters (m)."""
+        x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 3)
+        v = np.asarray(v, dtype=np.float64).reshape(-1, 3)
+        d = np.broadcast_to(np.asarray(d, dtype=np.float64), (len(x),))
+        cell, u, gradp = self.locate(x)
+        vp = np.pi * d**3 / 6.0
+        ncells = len(self.cell_volumes)
+        solid = np.bincount(cell, weights=vp, minlength=ncells) / self.cell_volumes
+        alpha = np.maximum(1.0 - solid, self.alpha_min)
+        slip = u - v
+        k = self.drag_law(alpha[cell], np.linalg.norm(slip, axis=1), d, self.rho, self.nu)
+        ksum = np.bincount(cell, weights=k, minlength=ncells)
+        kv = np.stack([np.bincount(cell, weights=k * v[:, i], minlength=ncells)
+                       for i in range(3)], axis=1)
+        self._alpha = alpha
+        self._ksl = ksum / self.cell_volumes
+        self._us = np.divide(kv, ksum[:, None], out=np.zeros_like(kv), where=ksum[:, None] > 0)
+        return k[:, None] * slip - (vp * self.rho)[:, None] * gradp
+
+    def locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Cell of each position (global index over ranks), fluid velocity (m/s) and kinematic
+        pressure gradient (m/s^2) there, interpolated as controlDict's
+        ``particleInterpolation`` says (default ``cell``). ValueError if a point is outside."""
+        x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 3)
+        n = len(x)
+        request = np.int32(LOCATE).tobytes() + np.int32(n).tobytes() + x.tobytes()
+        for rank in range(self.nprocs):
+            self._send(rank, request)
+        cell = np.full(n, -1, dtype=np.int64)
+        u, gradp = np.zeros((n, 3)), np.zeros((n, 3))
+        for rank in range(self.nprocs):
+            c = self._read(rank, np.int32, n)
+            ur = self._read(rank, np.float64, 3 * n).reshape(n, 3)
+            gr = self._read(rank, np.float64, 3 * n).reshape(n, 3)
+            mine = (c >= 0) & (cell < 0)
+            cell[mine] = c[mine] + self.offsets[rank]
+            u[mine], gradp[mine] = ur[mine], gr[mine]
+        if np.any(cell < 0):
+            lost = np.flatnonzero(cell < 0)
+            raise ValueError(f"{len(lost)} point(s) outside the fluid mesh, e.g. index {lost[0]} "
+                             f"at {x[lost[0]].tolist()} m")
+        return cell, u, gradp
+
+    def advance(self, duration: float, steps: int = 1) -> float:
+        """Advance the fluid by ``duration`` (s) in ``steps`` equal time steps with the
+        particle fields of the last :meth:`particle_forces`; returns the fluid time (s)."""
+        if duration <= 0 or steps < 1:
+            raise ValueError(f"need duration > 0 and steps >= 1, got {duration}, {steps}")
+        head = (np.int32(ADVANCE).tobytes() + np.float64(duration / steps).tobytes()
+                + np.int32(steps).tobytes())
+        for rank in range(self.nprocs):
+            a, b = self.offsets[rank], self.offsets[rank + 1]
+            self._send(rank, head + self._alpha[a:b].tobytes() + self._ksl[a:b].tobytes()
+                       + np.ascontiguousarray(self._us[a:b]).tobytes())
+        for rank in range(self.nprocs):
+            self.time = float(self._read(rank, np.float64, 1)[0])
+        return self.time
+
+    def couple(self, x, v, d, duration: float, steps: int = 1) -> np.ndarray:
+        """One coupling step: the force on each particle (N) from the current fluid, then the
+        fluid advanced by ``duration`` (s) with these particles' fluid fraction and drag."""
+        forces = self.particle_forces(x, v, d)
+        self.advance(duration, steps)
+        return forces
+
+    def fields(self) -> tuple[np.ndarray, np.ndarray]:
+        """Pressure (Pa) and velocity (m/s) of every cell, in the order of ``cell_centres``."""
+        for rank in range(self.nprocs):
+            self._send(rank, np.int32(FIELDS).tobytes())
+        p, u = [], []
+        for rank in range(self.nprocs):
+            nc = self.rank_cells[rank]
+            p.append(self._read(rank, np.float64, nc) * self.rho)
+            u.append(self._read(rank, np.float64, 3 * nc).reshape(nc, 3))
+        return np.concatenate(p), np.concatenate(u)
+
+    @property
+    def alpha(self) -> np.ndarray:
+        """Fluid volume fraction of every cell as last sent (-)."""
+        return self._alpha
+
+    def write(self) -> float:
+        """Write all fields at the current fluid time; returns that time (s)."""
+        for rank in range(self.nprocs):
+            self._send(rank, np.int32(WRITE).tobytes())
+        for rank in range(self.nprocs):
+            self.time = float(self._read(rank, np.float64, 1)[0])
+        return self.time
+
+    # -- pipes ------------------------------------------------------------------------
+    def _failed(self, what: str) -> FluidError:
+        if self.proc is not None and self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+        rc = None if self.proc is None else self.proc.returncode
+        return FluidError(f"the fluid solver stopped while {what} (exit code {rc}); "
+                          f"end of {self.log}:\n{log_tail(self.log)}")
+
+    def _open_writer(self, path: Path) -> int:
+        deadline = time.monotonic() + self.timeout
+        while True:
+            try:
+                fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK)
+                break
+            except OSError:  # ENXIO: the solver has not opened its end yet
+                if self.proc.poll() is not None or time.monotonic() > deadline:
+                    raise self._failed("starting") from None
+                time.sleep(0.005)
+        fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) & ~os.O_NONBLOCK)
+        return fd
+
+    def _send(self, rank: int, data: bytes) -> None:
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(self._fds[rank][0], view):]
+        except (BrokenPipeError, IndexError):
+            raise self._failed("receiving a request") from None
+
+    def _read(self, rank: int, dtype, count: int) -> np.ndarray:
+        fd = self._fds[rank][1]
+        need = np.dtype(dtype).itemsize * count
+        chunks, got = [], 0
+        deadline = time.monotonic() + self.timeout
+        while got < need:
+            ready, _, _ = select.select([fd], [], [], 0.5)
+            if not ready:
+                if self.proc.poll() is not None or time.monotonic() > deadline:
+                    raise self._failed("computing")
+                continue
+            chunk = os.read(fd, need - got)
+            if not chunk:
+                raise self._failed("computing")
+            chunks.append(chunk)
+            got += len(chunk)
+        return np.frombuffer(b"".join(chunks), dtype=dtype)
+
+
+def _value(entry) -> float:
+    """A number from an OpenFOAM entry that may carry a name and dimensions."""
+    return float(getattr(entry, "value", entry))
