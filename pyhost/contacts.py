@@ -33,36 +33,63 @@ class Contacts:
         return len(self.i)
 
 
+class ContactFinder:
+    """Contacts among particles of radii r [m] in box = (xmin, xmax, ..., zmax), periodic where
+    asked, with the box walls named in ``walls`` ("zlo", ...).
+
+    A Verlet list: candidate pairs within 2 r_max + skin come from scipy's cKDTree and are
+    reused until some particle has moved more than skin/2 since they were found, which
+    cannot miss a contact (two particles close in by at most skin between rebuilds).
+    """
+
+    def __init__(self, r, box, periodic=(False, False, False), walls=(), skin=None):
+        self.r = np.asarray(r, float)
+        self.lo, self.hi = np.array(box[0::2], float), np.array(box[1::2], float)
+        self.size = self.hi - self.lo
+        self.per = np.asarray(periodic, bool)
+        self.walls = tuple(walls)
+        self.skin = 0.5 * self.r.max() if skin is None else skin
+        self.x_built, self.pairs, self.rebuilds = None, None, 0
+
+    def _wrap(self, d):
+        return d - np.where(self.per, self.size * np.round(d / self.size), 0.0)
+
+    def _rebuild(self, x) -> None:
+        cutoff = 2.0 * self.r.max() + self.skin
+        if self.per.any():
+            # cKDTree wraps every axis of boxsize: non-periodic axes get a box 4x the domain,
+            # with the points shifted into its middle, so that no pair meets across its wrap
+            pts = np.where(self.per, np.mod(x - self.lo, self.size), x - self.lo + self.size)
+            tree = cKDTree(pts, boxsize=np.where(self.per, self.size, 4.0 * self.size))
+        else:
+            tree = cKDTree(x)
+        self.pairs = tree.query_pairs(cutoff, output_type="ndarray") if len(x) > 1 else np.empty((0, 2), int)
+        self.x_built = x.copy()
+        self.rebuilds += 1
+
+    def __call__(self, x, v) -> Contacts:
+        x, v, r = np.asarray(x, float), np.asarray(v, float), self.r
+        if self.x_built is None or np.max(np.sum(self._wrap(x - self.x_built) ** 2, axis=1)) > (0.5 * self.skin) ** 2:
+            self._rebuild(x)
+        i, j = self.pairs[:, 0], self.pairs[:, 1]
+        d = self._wrap(x[i] - x[j])
+        dist = np.sqrt(np.einsum("ij,ij->i", d, d))
+        delta = r[i] + r[j] - dist
+        keep = delta > 0
+        i, j, d, dist, delta = i[keep], j[keep], d[keep], dist[keep], delta[keep]
+        n = d / dist[:, None]
+        approach = -np.einsum("ij,ij->i", v[i] - v[j], n)
+        rows = [(i, j, delta, n, approach)]
+        for w, plane in enumerate(self.walls):
+            axis, side = AXIS[plane[0]], plane[1:]
+            gap = x[:, axis] - self.lo[axis] if side == "lo" else self.hi[axis] - x[:, axis]
+            k = np.flatnonzero(r - gap > 0)
+            nw = np.zeros((len(k), 3))
+            nw[:, axis] = 1.0 if side == "lo" else -1.0
+            rows.append((k, np.full(len(k), WALL_BASE + w), (r - gap)[k], nw, -np.einsum("ij,ij->i", v[k], nw)))
+        return Contacts(*(np.concatenate([row[c] for row in rows]) for c in range(5)))
+
+
 def find_contacts(x, v, r, box, periodic=(False, False, False), walls=()) -> Contacts:
-    """Contacts among particles at x [m] with velocities v [m/s] and radii r [m] in
-    box = (xmin, xmax, ymin, ymax, zmin, zmax); walls are plane names ("zlo", ...)."""
-    x, v, r = np.asarray(x, float), np.asarray(v, float), np.asarray(r, float)
-    lo, hi = np.array(box[0::2], float), np.array(box[1::2], float)
-    size = hi - lo
-    per = np.asarray(periodic, bool)
-    if per.any():
-        # cKDTree wraps every axis of boxsize: non-periodic axes get a box 4x the domain, with
-        # the points shifted into its middle, so that no pair can meet across its wrap
-        pts = np.where(per, np.mod(x - lo, size), x - lo + size)
-        tree = cKDTree(pts, boxsize=np.where(per, size, 4.0 * size))
-    else:
-        tree = cKDTree(x)
-    pairs = tree.query_pairs(2.0 * r.max(), output_type="ndarray") if len(r) > 1 else np.empty((0, 2), int)
-    i, j = pairs[:, 0], pairs[:, 1]
-    d = x[i] - x[j]
-    d -= np.where(per, size * np.round(d / size), 0.0)            # minimum image
-    dist = np.linalg.norm(d, axis=1)
-    delta = r[i] + r[j] - dist
-    keep = delta > 0
-    i, j, d, dist, delta = i[keep], j[keep], d[keep], dist[keep], delta[keep]
-    n = d / dist[:, None]
-    approach = -np.einsum("ij,ij->i", v[i] - v[j], n)
-    rows = [(i, j, delta, n, approach)]
-    for w, plane in enumerate(walls):
-        axis, side = AXIS[plane[0]], plane[1:]
-        gap = x[:, axis] - lo[axis] if side == "lo" else hi[axis] - x[:, axis]
-        k = np.flatnonzero(r - gap > 0)
-        nw = np.zeros((len(k), 3))
-        nw[:, axis] = 1.0 if side == "lo" else -1.0
-        rows.append((k, np.full(len(k), WALL_BASE + w), (r - gap)[k], nw, -np.einsum("ij,ij->i", v[k], nw)))
-    return Contacts(*(np.concatenate([row[c] for row in rows]) for c in range(5)))
+    """Contacts of one configuration (see ContactFinder, which reuses its search)."""
+    return ContactFinder(r, box, periodic, walls)(x, v)

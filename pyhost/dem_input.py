@@ -66,7 +66,8 @@ def place_particles(scene: Scene, seed: int = 12345) -> Particles:
             cells = cells[np.argsort(cells[:, 2], kind="stable")][: g.count]   # fill from the bottom
             jitter = rng.uniform(-0.04, 0.04, cells.shape) * g.radius
             pos = lo + g.radius + cells * spacing + jitter
-        parts.append((pos, np.broadcast_to(np.asarray(g.velocity, float), pos.shape), g))
+        vel = np.asarray(g.velocity, float) + rng.normal(0.0, 1.0, pos.shape) * g.velocity_spread
+        parts.append((pos, vel, g))
     mats = scene.materials
     return Particles(
         position=np.concatenate([p for p, _, _ in parts]),

@@ -19,7 +19,7 @@ import numpy as np
 
 from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat
 from pyhost.contact_heat import evaluate, restitution_impulse
-from pyhost.contacts import find_contacts
+from pyhost.contacts import ContactFinder
 from pyhost.dem_input import Particles, material_index
 from pyhost.output import CsvLog, Progress, VtkSeries
 
@@ -39,6 +39,8 @@ class Coupling:
         self.T = particles.temperature.astype(float).copy()
         self.C = particles.mass * np.array([m.heat_capacity for m in self.materials])[particles.material]
         self.tracker = ContactTracker()
+        d = scene.domain
+        self.contacts = ContactFinder(particles.radius, d.box, d.periodic, [w.plane for w in scene.walls])
         self.open = {}                  # contact key -> (start time, model t_coll, e, v0)
         self.t, self.step = 0.0, 0
         self.totals = dict(collisions=0, wall_collisions=0, heat_moved=0.0, heat_from_walls=0.0,
@@ -70,8 +72,7 @@ class Coupling:
 
     def sample_contacts(self, dt_sample: float) -> None:
         x, v = self.dem.state()
-        d = self.scene.domain
-        c = find_contacts(x, v, self.p.radius, d.box, d.periodic, [w.plane for w in self.scene.walls])
+        c = self.contacts(x, v)
         keys = contact_keys(c.i, c.j)
         opened, closed = self.tracker.update(keys)
         if len(opened):

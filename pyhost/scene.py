@@ -116,6 +116,7 @@ class Particles:
     region: list = spec(default=[], doc="xmin xmax ymin ymax zmin zmax where they are placed [m]")
     positions: list = spec(default=[], doc="explicit centres [[x, y, z], ...] [m], instead of region")
     velocity: list = spec(default=[0.0, 0.0, 0.0], doc="initial velocity [m/s]")
+    velocity_spread: float = spec(">=0", 0.0, "std. deviation of random velocity components added [m/s]")
 
 
 @dataclass(frozen=True)

@@ -47,3 +47,18 @@ def test_agrees_with_brute_force():
     d = np.linalg.norm(x[:, None] - x[None], axis=-1)
     overlap = (r[:, None] + r[None] - d > 0) & ~np.eye(300, dtype=bool)
     assert len(c) == overlap.sum() // 2
+
+
+def test_verlet_list_never_misses_a_contact():
+    from pyhost.contacts import ContactFinder
+    rng = np.random.default_rng(11)
+    x = rng.uniform(size=(200, 3))
+    r = np.full(200, 0.03)
+    finder = ContactFinder(r, BOX, periodic=(True, True, False), walls=("zlo",))
+    for _ in range(60):
+        x = x + rng.normal(scale=0.0008, size=x.shape)
+        x[:, :2] %= 1.0
+        got = finder(x, np.zeros_like(x))
+        fresh = find_contacts(x, np.zeros_like(x), r, BOX, periodic=(True, True, False), walls=("zlo",))
+        assert sorted(zip(got.i, got.j)) == sorted(zip(fresh.i, fresh.j))
+    assert 1 < finder.rebuilds < 60
