@@ -45,12 +45,14 @@ def _bc(kind, field: str) -> dict:
 
 def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, nu: float,
              gravity=(0.0, 0.0, -9.81), dt: float = 1e-3, nprocs: int = 1,
-             n_correctors: int = 2, n_outer: int = 1, max_speed: float = 1e3) -> Path:
+             n_correctors: int = 2, n_outer: int = 1, max_speed: float = 1e3,
+             rel_tol: float = 0.01) -> Path:
     """Write the case at ``path`` and return it. ``lo``, ``hi``: box corners (m);
     ``cells``: cells per axis; ``boundaries``: kind per face (module doc); ``rho`` (kg/m^3),
     ``nu`` (m^2/s): fluid; ``dt``: default time step (s); ``nprocs``: ranks of the
     decomposeParDict (method simple, split along x); ``n_correctors``, ``n_outer``: PISO and
-    PIMPLE loops; ``max_speed``: speed (m/s) taken as divergence."""
+    PIMPLE loops; ``max_speed``: speed (m/s) taken as divergence; ``rel_tol``: relative
+    tolerance of the pressure solver before the final corrector (absolute 1e-10)."""
     path = Path(path)
     missing = set(FACES) - set(boundaries)
     if missing:
@@ -87,7 +89,7 @@ def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, n
     solution = _dict(path / "system" / "fvSolution")
     solution.update({
         "solvers": {
-            "p": {"solver": "GAMG", "smoother": "DIC", "tolerance": 1e-10, "relTol": 0.01},
+            "p": {"solver": "GAMG", "smoother": "DIC", "tolerance": 1e-10, "relTol": rel_tol},
             "pFinal": {"solver": "GAMG", "smoother": "DIC", "tolerance": 1e-10, "relTol": 0},
             '"(U|UFinal)"': {"solver": "smoothSolver", "smoother": "symGaussSeidel",
                            "tolerance": 1e-10, "relTol": 0},

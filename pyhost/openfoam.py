@@ -15,6 +15,7 @@ import fcntl
 import os
 import select
 import shutil
+import signal
 import subprocess
 import time
 from pathlib import Path
@@ -258,7 +259,12 @@ class FluidSolver:
             self.proc.kill()
             self.proc.wait()
         rc = None if self.proc is None else self.proc.returncode
-        return FluidError(f"the fluid solver stopped while {what} (exit code {rc}); "
+        how = f"exit code {rc}"
+        if rc is not None and rc < 0:
+            how = f"killed by {signal.Signals(-rc).name}"
+            if -rc == signal.SIGFPE:
+                how += ": a floating point exception, the run diverged"
+        return FluidError(f"the fluid solver stopped while {what} ({how}); "
                           f"end of {self.log}:\n{log_tail(self.log)}")
 
     def _open_writer(self, path: Path) -> int:

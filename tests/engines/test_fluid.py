@@ -1,0 +1,157 @@
+"""Fluid bridge and collheatFoam on the real engines: settling sphere, Ergun bed, serial
+against two ranks, a diverging run."""
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from pyhost import drag
+from pyhost.fluid_case import box_case
+from pyhost.liggghts import Liggghts
+from pyhost.openfoam import FluidError, FluidSolver
+
+pytestmark = pytest.mark.engines
+
+WATER = dict(rho=1000.0, nu=1e-6)                     # kg/m^3, m^2/s
+WALLS = {f: "wall" for f in ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")}
+G = 9.81                                              # m/s^2
+
+
+@pytest.mark.parametrize("law", ["difelice", "gidaspow"])
+def test_sphere_settles_at_the_terminal_velocity_of_the_drag_law(tmp_path, law):
+    """A 1 mm glass sphere released in still water, moved by LIGGGHTS with the fluid force
+    from the bridge. The fluid column is one cell wide: the closed box keeps its fluid from
+    moving as a whole, so the drag law's own terminal velocity is the reference (in a wider
+    box point-particle CFD-DEM adds a self-induced slip of order d/(2 cell))."""
+    d, rho_p, cell = 1e-3, 2500.0, 4e-3                # m, kg/m^3, m
+    dt_dem, every, steps = 1e-4, 10, 250               # s, DEM steps per coupling, couplings
+    case = box_case(tmp_path / "fluid", lo=(0, 0, 0), hi=(cell, cell, 20 * cell),
+                    cells=(1, 1, 20), boundaries=WALLS, dt=every * dt_dem, **WATER)
+    with Liggghts(tmp_path / "dem") as dem, FluidSolver(case, drag=law) as fluid:
+        dem.commands(f"""
+            atom_style granular
+            atom_modify map array
+            boundary f f f
+            newton off
+            communicate single vel yes
+            units si
+            region box block 0 {cell} 0 {cell} 0 {20 * cell} units box
+            create_box 1 box
+            neighbor {d / 2} bin
+            fix m1 all property/global youngsModulus peratomtype 5e6
+            fix m2 all property/global poissonsRatio peratomtype 0.3
+            fix m3 all property/global coefficientRestitution peratomtypepair 1 0.9
+            fix m4 all property/global coefficientFriction peratomtypepair 1 0.5
+            pair_style gran model hertz tangential history
+            pair_coeff * *
+            timestep {dt_dem}
+            create_atoms 1 single {cell / 2} {cell / 2} {18.5 * cell} units box
+            set atom 1 diameter {d} density {rho_p}
+            fix gravity all gravity {G} vector 0 0 -1
+            fix fluid all external pf/array 1
+            fix integrate all nve/sphere
+        """)
+        dem.run(0)
+        vz = []
+        for _ in range(steps):
+            force = fluid.couple(dem.atom("x"), dem.atom("v"), 2 * dem.atom("radius"),
+                                 every * dt_dem)
+            dem.external_force("fluid")[:] = force
+            dem.run(every)
+            vz.append(-dem.atom("v")[0, 2])
+        alpha = fluid.alpha.min()                      # the fluid fraction around the sphere
+    vp = np.pi * d**3 / 6
+    weight = (rho_p - WATER["rho"]) * vp * G           # N, gravity less buoyancy
+    law_k = drag.get(law)
+    v_terminal = brentq(lambda s: law_k(alpha, s, d, **WATER) * s - weight, 1e-6, 10.0)
+    v_end = np.mean(vz[-20:])
+    print(f"{law}: terminal {v_end:.5f} m/s, law {v_terminal:.5f} m/s, "
+          f"error {v_end / v_terminal - 1:+.2%}")
+    assert vz[-1] == pytest.approx(vz[-20], rel=1e-2)  # it is steady
+    assert v_end == pytest.approx(v_terminal, rel=0.03)
+
+
+def ergun_gradient(u_s, alpha, d, rho, nu):
+    """Ergun (1952): pressure drop per length (Pa/m) across a packed bed at superficial
+    velocity u_s (m/s), fluid fraction alpha, particle diameter d (m)."""
+    return (150 * (1 - alpha)**2 * rho * nu * u_s / (alpha**3 * d**2)
+            + 1.75 * (1 - alpha) * rho * u_s**2 / (alpha**3 * d))
+
+
+@pytest.mark.parametrize("u_s", [2e-3, 2e-2])
+def test_fixed_packed_bed_pressure_drop_matches_ergun(tmp_path, u_s):
+    """Water up through a fixed simple-cubic bed of touching 2 mm spheres (fluid fraction
+    1 - pi/6), 8 per 4 mm cell, between two particle-free layers; Gidaspow's law."""
+    d, cell = 2e-3, 4e-3
+    nz, bed = 16, range(4, 12)                          # cells, bed rows
+    case = box_case(tmp_path / "bed", lo=(0, 0, 0), hi=(2 * cell, 2 * cell, nz * cell),
+                    cells=(2, 2, nz), gravity=(0, 0, 0), dt=0.02,
+                    boundaries={"xlo": "slip", "xhi": "slip", "ylo": "slip", "yhi": "slip",
+                                "zlo": ("inlet", (0, 0, u_s)), "zhi": "outlet"}, **WATER)
+    axis = (np.arange(2 * 2) + 0.5) * d                # two spheres per cell and axis
+    x, y, z = np.meshgrid(axis, axis, (np.arange(2 * len(bed)) + 0.5) * d + bed[0] * cell,
+                          indexing="ij")
+    centres = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
+    with FluidSolver(case, drag="gidaspow") as fluid:
+        for _ in range(40):
+            fluid.couple(centres, np.zeros_like(centres), d, 0.02)
+        p, _ = fluid.fields()
+        zc = fluid.cell_centres[:, 2]
+        alpha = fluid.alpha
+    inside = (zc > (bed[0] + 1) * cell) & (zc < (bed[-1]) * cell)
+    assert np.allclose(alpha[inside], 1 - np.pi / 6, rtol=1e-12)
+    slope = -np.polyfit(zc[inside], p[inside], 1)[0]    # Pa/m
+    expected = ergun_gradient(u_s, 1 - np.pi / 6, d, **WATER)
+    print(f"u_s = {u_s} m/s: dp/dz {slope:.2f} Pa/m, Ergun {expected:.2f} Pa/m, "
+          f"error {slope / expected - 1:+.2%}")
+    assert slope == pytest.approx(expected, rel=0.05)
+
+
+def lid_box(path, nprocs):
+    """A 2-D-like box with a 0.1 m/s inflow on one side wall and an outlet on top; the
+    pressure solved to 1e-10 absolute at every corrector."""
+    return box_case(path, lo=(0, 0, 0), hi=(0.04, 0.01, 0.04), cells=(16, 1, 16),
+                    gravity=(0, 0, -9.81), dt=5e-3, nprocs=nprocs, rel_tol=0.0,
+                    boundaries={"xlo": ("inlet", (0.1, 0, 0)), "xhi": "wall", "ylo": "slip",
+                                "yhi": "slip", "zlo": "wall", "zhi": "outlet"}, **WATER)
+
+
+def test_serial_and_two_ranks_agree(tmp_path):
+    """Same case with particles in it, serial and with mpirun -np 2 (method simple)."""
+    rng = np.random.default_rng(10007)
+    x = rng.uniform((0.002, 0.001, 0.002), (0.038, 0.009, 0.038), (200, 3))
+    v = rng.normal(0, 0.05, (200, 3))
+    results = []
+    for nprocs in (1, 2):
+        with FluidSolver(lid_box(tmp_path / f"np{nprocs}", nprocs), nprocs=nprocs,
+                         drag="difelice") as fluid:
+            for _ in range(20):
+                force = fluid.couple(x, v, 1e-3, 5e-3)
+            p, u = fluid.fields()
+            order = np.lexsort(np.round(fluid.cell_centres, 9).T)  # same order for both
+            results.append((force, p[order], u[order], fluid.rank_cells))
+    (f1, p1, u1, _), (f2, p2, u2, ranks) = results
+    assert len(ranks) == 2 and min(ranks) > 0
+    u_scale, p_scale = np.abs(u1).max(), np.ptp(p1)
+    print(f"max |dU| / max|U| = {np.abs(u1 - u2).max() / u_scale:.2e}, "
+          f"max |dp| / range p = {np.abs(p1 - p2).max() / p_scale:.2e}, "
+          f"max |dF| / max|F| = {np.abs(f1 - f2).max() / np.abs(f1).max():.2e}")
+    # Solver tolerances 1e-10 (p) and 1e-10 (U) absolute: agree to 1e-6 relative.
+    assert np.abs(u1 - u2).max() <= 1e-6 * u_scale
+    assert np.abs(p1 - p2).max() <= 1e-6 * p_scale
+    assert np.abs(f1 - f2).max() <= 1e-6 * np.abs(f1).max()
+
+
+def test_diverging_run_raises_with_the_solver_message(tmp_path):
+    """Inflow of 50 m/s through 1 mm cells with a 1 s step: the run blows up; the host
+    gets FluidError with the log's end and goes on (it can start another solver)."""
+    case = box_case(tmp_path / "bad", lo=(0, 0, 0), hi=(0.01, 0.001, 0.01), cells=(10, 1, 10),
+                    dt=1.0, max_speed=100.0, n_correctors=1,
+                    boundaries={"xlo": ("inlet", (50, 0, 0)), "xhi": "outlet", "ylo": "slip",
+                                "yhi": "slip", "zlo": "wall", "zhi": "wall"}, **WATER)
+    with pytest.raises(FluidError, match="diverged") as err:
+        with FluidSolver(case) as fluid:
+            for _ in range(50):
+                fluid.advance(1.0)
+    assert "log.collheatFoam" in str(err.value)
+    with FluidSolver(lid_box(tmp_path / "after", 1)) as fluid:
+        assert fluid.advance(5e-3) == pytest.approx(5e-3)
