@@ -26,6 +26,7 @@ from typing import Iterable
 import numpy as np
 
 LIB = "libliggghts.so.3"
+_ISOLATED = "OMPI_MCA_ess_singleton_isolated"
 HELPER = Path(__file__).resolve().parents[1] / ".setup" / "lib" / "libcollheat_liggghts.so"
 
 _c = ctypes
@@ -94,6 +95,29 @@ _PAIR_KEYWORDS = "vel id contactArea delta"
 _WALL_KEYWORDS = _PAIR_KEYWORDS
 
 
+def granular_box(lo, hi, *, youngs: float, poisson: float, restitution: float,
+                 friction: float, skin: float, dt: float) -> list[str]:
+    """Commands opening a one-material granular SI simulation in the box ``lo``-``hi`` (m)
+    with fixed boundaries, with the settings this bridge relies on (atom map, newton off,
+    ghost velocities): Hertz contacts of Young's modulus ``youngs`` (Pa), Poisson ratio,
+    restitution and friction coefficients, neighbour ``skin`` (m) and time step ``dt`` (s)."""
+    num = lambda x: repr(float(x))  # every digit of the double
+    box = " ".join(f"{num(a)} {num(b)}" for a, b in zip(lo, hi))
+    return [
+        "atom_style granular", "atom_modify map array", "boundary f f f", "newton off",
+        "communicate single vel yes", "units si",
+        *(["hard_particles yes"] if youngs > 1e9 else []),
+        f"region box block {box} units box", "create_box 1 box",
+        f"neighbor {num(skin)} bin", "neigh_modify delay 0",
+        f"fix m1 all property/global youngsModulus peratomtype {num(youngs)}",
+        f"fix m2 all property/global poissonsRatio peratomtype {num(poisson)}",
+        f"fix m3 all property/global coefficientRestitution peratomtypepair 1 {num(restitution)}",
+        f"fix m4 all property/global coefficientFriction peratomtypepair 1 {num(friction)}",
+        "pair_style gran model hertz tangential history", "pair_coeff * *",
+        f"timestep {num(dt)}",
+    ]
+
+
 class Liggghts:
     """One LIGGGHTS instance in this process (serial, no MPI communicator of ours).
 
@@ -102,9 +126,6 @@ class Liggghts:
     """
 
     def __init__(self, workdir: str | os.PathLike | None = None, *, check: bool = True):
-        # A forked copy must be able to call MPI_Finalize without the parent's MPI server.
-        os.environ.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
-        os.environ.setdefault("OMPI_MCA_btl", "self")
         if not HELPER.is_file():
             raise LiggghtsError(f"{HELPER} is missing: run tools/setup.sh --engines")
         self._tmp = None if workdir else tempfile.TemporaryDirectory(prefix="liggghts-")
@@ -119,7 +140,18 @@ class Liggghts:
         args = [b"liggghts", b"-screen", str(self.log).encode(), b"-log", b"none"]
         argv = (_cp * len(args))(*args)
         self.ptr = _vp()
-        self.lib.lammps_open_no_mpi(len(args), argv, ctypes.byref(self.ptr))
+        # A forked copy must be able to call MPI_Finalize without a server of the parent's
+        # MPI: a singleton MPI without one. Set only while MPI starts (mpirun's children
+        # must not inherit it).
+        saved = os.environ.get(_ISOLATED)
+        os.environ[_ISOLATED] = "1"
+        try:
+            self.lib.lammps_open_no_mpi(len(args), argv, ctypes.byref(self.ptr))
+        finally:
+            if saved is None:
+                del os.environ[_ISOLATED]
+            else:
+                os.environ[_ISOLATED] = saved
         self.helper.collheat_watch_exit(str(self.log).encode())
         self._changed = True  # a command since the last run: try the next run first
 

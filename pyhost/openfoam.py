@@ -39,7 +39,6 @@ def foam_env() -> dict:
     env.setdefault("WM_PROJECT_DIR", "/usr/share/openfoam")
     env.setdefault("USER", "root")
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    env.pop("OMPI_MCA_ess_singleton_isolated", None)  # set by pyhost.liggghts for its forks
     return env
 
 

@@ -6,7 +6,7 @@ from scipy.optimize import brentq
 
 from pyhost import drag
 from pyhost.fluid_case import box_case
-from pyhost.liggghts import Liggghts
+from pyhost.liggghts import Liggghts, granular_box
 from pyhost.openfoam import FluidError, FluidSolver
 
 pytestmark = pytest.mark.engines
@@ -27,23 +27,9 @@ def test_sphere_settles_at_the_terminal_velocity_of_the_drag_law(tmp_path, law):
     case = box_case(tmp_path / "fluid", lo=(0, 0, 0), hi=(cell, cell, 20 * cell),
                     cells=(1, 1, 20), boundaries=WALLS, dt=every * dt_dem, **WATER)
     with Liggghts(tmp_path / "dem") as dem, FluidSolver(case, drag=law) as fluid:
+        dem.commands(granular_box((0, 0, 0), (cell, cell, 20 * cell), youngs=5e6, poisson=0.3,
+                                  restitution=0.9, friction=0.5, skin=d / 2, dt=dt_dem))
         dem.commands(f"""
-            atom_style granular
-            atom_modify map array
-            boundary f f f
-            newton off
-            communicate single vel yes
-            units si
-            region box block 0 {cell} 0 {cell} 0 {20 * cell} units box
-            create_box 1 box
-            neighbor {d / 2} bin
-            fix m1 all property/global youngsModulus peratomtype 5e6
-            fix m2 all property/global poissonsRatio peratomtype 0.3
-            fix m3 all property/global coefficientRestitution peratomtypepair 1 0.9
-            fix m4 all property/global coefficientFriction peratomtypepair 1 0.5
-            pair_style gran model hertz tangential history
-            pair_coeff * *
-            timestep {dt_dem}
             create_atoms 1 single {cell / 2} {cell / 2} {18.5 * cell} units box
             set atom 1 diameter {d} density {rho_p}
             fix gravity all gravity {G} vector 0 0 -1

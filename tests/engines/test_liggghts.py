@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from pyhost.liggghts import Liggghts, LiggghtsError
+from pyhost.liggghts import Liggghts, LiggghtsError, granular_box
 
 pytestmark = pytest.mark.engines
 
@@ -16,26 +16,11 @@ V, DT = 1.0, 1e-6                               # m/s each (head-on), s
 
 def two_spheres(workdir) -> Liggghts:
     lg = Liggghts(workdir)
+    lg.commands(granular_box((-0.01,) * 3, (0.01,) * 3, youngs=E, poisson=NU, restitution=1.0,
+                             friction=0.5, skin=R / 2, dt=DT))
     lg.commands(f"""
-        atom_style granular
-        atom_modify map array
-        boundary f f f
-        newton off
-        communicate single vel yes
-        units si
-        region box block -0.01 0.01 -0.01 0.01 -0.01 0.01 units box
-        create_box 1 box
-        neighbor {R / 2} bin
-        neigh_modify delay 0
-        fix m1 all property/global youngsModulus peratomtype {E}
-        fix m2 all property/global poissonsRatio peratomtype {NU}
-        fix m3 all property/global coefficientRestitution peratomtypepair 1 1.0
-        fix m4 all property/global coefficientFriction peratomtypepair 1 0.5
         fix m5 all property/global thermalConductivity peratomtype {K}
         fix m6 all property/global thermalCapacity peratomtype {C}
-        pair_style gran model hertz tangential history
-        pair_coeff * *
-        timestep {DT}
         create_atoms 1 single {-1.5 * R} 0 0 units box
         create_atoms 1 single {1.5 * R} 0 0 units box
         set atom 1 diameter {2 * R} density {RHO} vx {V}
