@@ -31,6 +31,7 @@ class Particles:
     density: np.ndarray         # [kg/m^3]
     temperature: np.ndarray     # [K]
     material: np.ndarray        # index into scene.materials (atom type - 1)
+    group: np.ndarray           # index of the scene's [[particles]] group
 
     @property
     def mass(self):
@@ -76,6 +77,7 @@ def place_particles(scene: Scene, seed: int = 12345) -> Particles:
         density=np.concatenate([np.full(len(p), mats[g.material].density) for p, _, g in parts]),
         temperature=np.concatenate([np.full(len(p), g.temperature) for p, _, g in parts]),
         material=np.concatenate([np.full(len(p), index[g.material]) for p, _, g in parts]),
+        group=np.concatenate([np.full(len(p), k) for k, (p, _, _) in enumerate(parts)]),
     )
 
 

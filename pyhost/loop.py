@@ -47,8 +47,10 @@ class Coupling:
                            capped=0, clipped=0, enduring_heat=0.0)
         self.CT0 = float(np.sum(self.C * self.T))
         self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS)
-        self.history = CsvLog(self.out / "history.csv", ("time", "T_mean", "T_min", "T_max", "sum_mcT",
-                                                         "heat_from_walls", "collisions", "capped", "clipped"))
+        self.groups = [np.flatnonzero(particles.group == k) for k in range(len(scene.particles))]
+        self.history = CsvLog(self.out / "history.csv", ("time", "T_mean", "T_min", "T_max")
+                              + tuple(f"T_group{k}" for k in range(len(self.groups)))
+                              + ("sum_mcT", "heat_from_walls", "collisions", "capped", "clipped"))
         self.frames = VtkSeries(self.out / "vtk", "particles") if scene.output.vtk else None
         self.progress = Progress(scene.time.end, progress_every)
 
@@ -175,9 +177,10 @@ class Coupling:
 
     def write_frame(self) -> None:
         tot = self.totals
-        self.history.write([(self.t, float(self.T.mean()), float(self.T.min()), float(self.T.max()),
-                             float(np.sum(self.C * self.T)), tot["heat_from_walls"], tot["collisions"],
-                             tot["capped"], tot["clipped"])])
+        group_means = tuple(float(np.sum(self.C[g] * self.T[g]) / np.sum(self.C[g])) for g in self.groups)
+        self.history.write([(self.t, float(self.T.mean()), float(self.T.min()), float(self.T.max()))
+                            + group_means + (float(np.sum(self.C * self.T)), tot["heat_from_walls"],
+                                             tot["collisions"], tot["capped"], tot["clipped"])])
         if self.frames is not None:
             x, v = self.dem.state()
             self.frames.write(self.t, x, id=np.arange(1, len(x) + 1), radius=self.p.radius, velocity=v,

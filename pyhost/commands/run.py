@@ -4,6 +4,8 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 HELP = "run a case: DEM (+ fluid) with collision heat as its case.toml asks"
@@ -51,4 +53,8 @@ def run(args) -> int:
     finally:
         dem.close()
     print("summary:", json.dumps(summary, indent=1))
+    if scene.output.pictures:        # own process: see pyhost/commands/pictures.py
+        drawn = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(out)])
+        if drawn.returncode != 0:
+            print(f"warning: pictures failed (exit {drawn.returncode}); the run's data are in {out}")
     return 0

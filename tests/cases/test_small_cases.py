@@ -61,3 +61,16 @@ def test_wall_impact_matches_plugin_and_balances(tmp_path):
     # the particle's heat content changed by exactly what came from the wall
     assert summary["heat_from_walls"] == pytest.approx(-ref.Q, rel=0.01)
     assert summary["energy_balance_error"] == pytest.approx(0, abs=1e-12)
+
+
+def test_hot_cold_box_smoke_conserves_and_converges(tmp_path):
+    rows, summary = run_case("hot-cold-box", tmp_path, "--test")
+    assert summary["collisions"] > 1000 and summary["capped"] == 0
+    assert abs(summary["energy_balance_error"]) < 1e-12
+    hist = list(csv.DictReader(open(tmp_path / "history.csv")))
+    hot = float(hist[-1]["T_group0"]) - float(hist[0]["T_group0"])
+    cold = float(hist[-1]["T_group1"]) - float(hist[0]["T_group1"])
+    assert hot < 0 < cold
+    assert hot == pytest.approx(-cold, rel=1e-6)          # equal heat capacities
+    assert (tmp_path / "temperatures.png").stat().st_size > 10000
+    assert (tmp_path / "particles.png").stat().st_size > 10000
