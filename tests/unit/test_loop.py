@@ -4,6 +4,7 @@ The real-engine versions of these scenes are the cases; here the DEM is a stand-
 the host's own logic (detection, impact speed, heat, restitution, conservation) is tested
 on its own.
 """
+import csv
 import json
 
 import numpy as np
@@ -123,3 +124,32 @@ def test_isothermal_scene_samples_nothing(tmp_path):
     _, _, dem, summary = run(tmp_path, model="none")
     assert summary["collisions"] == 0
     assert dem.calls == 0          # no VTK frames asked for, and no contact sampling
+
+
+RESTING = SCENE.replace('positions = [[0.045, 0.005, 0.01], [0.0492, 0.005, 0.01]]',
+                        'positions = [[0.045, 0.005, 0.0021], [0.06, 0.005, 0.0021]]') \
+    .replace("gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, 0.0, -9.81]") \
+    .replace("dem_step = 5e-7", "dem_step = 5e-6").replace("end = 1e-3", "end = 0.03") \
+    .replace("restitution = 0.9", "restitution = 0.3") \
+    .replace("[domain]", '[[walls]]\nplane = "zlo"\nmaterial = "steel"\ntemperature = 400.0\n[domain]')
+
+
+@pytest.mark.parametrize("enduring", [False, True])
+def test_resting_contact_conducts_only_when_enduring_is_on(tmp_path, enduring):
+    text = RESTING.format(model="A", feedback="false").replace(
+        "restitution_feedback = false", f"restitution_feedback = false\nenduring_conduction = {str(enduring).lower()}")
+    (tmp_path / "case.toml").write_text(text)
+    scene = load_scene(tmp_path / "case.toml")
+    p = place_particles(scene)
+    dem = NumpyDem(scene, p)
+    summary = Coupling(scene, dem, p, tmp_path / "out", progress_every=1e9).run()
+    assert abs(summary["energy_balance_error"]) < 1e-12
+    rows = list(csv.DictReader(open(tmp_path / "out" / "collisions.csv")))
+    collision_heat = -sum(float(r["Q"]) for r in rows if r["wall"] != "0")
+    assert summary["wall_collisions"] >= 2                      # bounces, then rests
+    if enduring:
+        assert summary["enduring_heat"] > 0
+        assert summary["heat_from_walls"] == pytest.approx(collision_heat + summary["enduring_heat"], rel=1e-9)
+    else:
+        assert summary["enduring_heat"] == 0
+        assert summary["heat_from_walls"] == pytest.approx(collision_heat, rel=1e-12)
