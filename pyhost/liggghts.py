@@ -44,8 +44,9 @@ _DECLARATIONS = {
     "lammps_get_natoms": (_int, [_vp]),
 }
 _HELPER_DECLARATIONS = {
-    "collheat_watch_exit": (None, [_cp]),
+    "collheat_watch_exit": (None, [_vp, _cp]),
     "collheat_flush": (None, [_vp]),
+    "collheat_set_screen": (_int, [_vp, _cp]),
     "collheat_compute_local": (_int, [_vp, _cp, _c.POINTER(_int), _c.POINTER(_int),
                                       _c.POINTER(_c.POINTER(_c.c_double))]),
     "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
@@ -73,9 +74,9 @@ def _declare(lib: ctypes.CDLL, table: dict) -> None:
 class Contacts:
     """Contacts overlapping now, one row each (all SI).
 
-    ``i``, ``j``: atom ids (``j`` is 0 for a wall contact); ``delta``: normal overlap (m);
-    ``vi``, ``vj``: velocities of the two (m/s; ``vj`` zero for a wall), so the relative
-    velocity is ``vi - vj``; ``area``: contact area (m^2) as LIGGGHTS computes it.
+    ``i``, ``j``: atom ids (for a wall contact ``j`` is the wall's index); ``delta``: normal
+    overlap (m); ``vi``, ``vj``: velocities of the two (m/s; ``vj`` is the wall's), so the
+    relative velocity is ``vi - vj``; ``area``: contact area (m^2) as LIGGGHTS computes it.
     """
 
     i: np.ndarray
@@ -92,7 +93,6 @@ class Contacts:
 # compute pair/gran/local with these columns, in LIGGGHTS' own column order:
 # vel (6), id (3: i, j, periodic), contactArea (1), delta (1).
 _PAIR_KEYWORDS = "vel id contactArea delta"
-_WALL_KEYWORDS = _PAIR_KEYWORDS
 
 
 def granular_box(lo, hi, *, youngs: float, poisson: float, restitution: float,
@@ -133,8 +133,9 @@ class Liggghts:
         self.workdir.mkdir(parents=True, exist_ok=True)
         self.log = self.workdir / "log.liggghts"
         self.check = check
-        self.lib = ctypes.CDLL(LIB, mode=ctypes.RTLD_GLOBAL)
+        # The helper first: its MPI_Abort must come before OpenMPI's (see plugins/liggghts).
         self.helper = ctypes.CDLL(str(HELPER), mode=ctypes.RTLD_GLOBAL)
+        self.lib = ctypes.CDLL(LIB, mode=ctypes.RTLD_GLOBAL)
         _declare(self.lib, _DECLARATIONS)
         _declare(self.helper, _HELPER_DECLARATIONS)
         args = [b"liggghts", b"-screen", str(self.log).encode(), b"-log", b"none"]
@@ -152,7 +153,7 @@ class Liggghts:
                 del os.environ[_ISOLATED]
             else:
                 os.environ[_ISOLATED] = saved
-        self.helper.collheat_watch_exit(str(self.log).encode())
+        self.helper.collheat_watch_exit(self.ptr, str(self.log).encode())
         self._changed = True  # a command since the last run: try the next run first
 
     # -- commands ---------------------------------------------------------------------
@@ -194,30 +195,29 @@ class Liggghts:
         self._changed = False
 
     def _tried(self, call, what: str) -> None:
-        """Run ``call`` in a forked copy of this process; raise if LIGGGHTS ended it."""
+        """Run ``call`` in a forked copy of this process, its LIGGGHTS output going to a
+        file of its own; raise LiggghtsError with LIGGGHTS' message if the copy died."""
         if not self.check:
             return
         self.helper.collheat_flush(self.ptr)
-        start = self.log.stat().st_size if self.log.exists() else 0
+        trial = self.workdir / "log.trial"
         pid = os.fork()
         if pid == 0:  # the copy: never returns into Python's normal flow
             try:
-                self.helper.collheat_watch_exit(b"")  # the parent reports, not the copy
+                self.helper.collheat_watch_exit(self.ptr, b"")  # the parent reports, not the copy
+                self.helper.collheat_set_screen(self.ptr, str(trial).encode())
                 call()
                 self.helper.collheat_flush(self.ptr)
             finally:
                 os._exit(0)
         _, status = os.waitpid(pid, 0)
         if os.waitstatus_to_exitcode(status) != 0:
-            with open(self.log, "rb") as f:
-                f.seek(start)
-                text = f.read().decode(errors="replace")
-            # The copy's output is not this process's: cut it from the log again.
-            os.truncate(self.log, start)
+            text = trial.read_text(errors="replace") if trial.exists() else ""
+            trial.unlink(missing_ok=True)
             errors = [ln for ln in text.splitlines() if ln.startswith("ERROR")]
             message = errors[-1] if errors else (text.strip().splitlines() or ["no message"])[-1]
             raise LiggghtsError(f"LIGGGHTS refused '{what}': {message}")
-        os.truncate(self.log, start)
+        trial.unlink(missing_ok=True)
 
     # -- per-atom data ----------------------------------------------------------------
     @property
@@ -285,11 +285,11 @@ class Liggghts:
         style, before the first run)."""
         self.command(f"compute {compute_id} all pair/gran/local {_PAIR_KEYWORDS}")
 
-    def add_wall_contacts(self, compute_id: str = "walls", wall_fix: str | None = None) -> None:
-        """Define the wall-contact compute read by :meth:`wall_contacts`. Mesh walls need no
-        ``wall_fix``; primitive walls need ``store_force yes`` on their ``fix wall/gran``."""
-        extra = f" wall {wall_fix}" if wall_fix else ""
-        self.command(f"compute {compute_id} all wall/gran/local {_WALL_KEYWORDS}{extra}")
+    def add_wall_contacts(self, compute_id: str = "walls") -> None:
+        """Define the mesh-wall contact compute read by :meth:`wall_contacts` (after the
+        ``fix wall/gran ... mesh`` it reports on). LIGGGHTS reports mesh walls only: for
+        primitive planes use :meth:`plane_contacts`."""
+        self.command(f"compute {compute_id} all wall/gran/local {_PAIR_KEYWORDS}")
 
     def local_array(self, compute_id: str) -> np.ndarray:
         """A local compute's rows on the current step, as a (rows, cols) copy."""
@@ -304,23 +304,39 @@ class Liggghts:
 
     def pair_contacts(self, compute_id: str = "pairs") -> Contacts:
         """Particle-particle contacts now (see :class:`Contacts`)."""
-        return self._contacts(self.local_array(compute_id))
-
-    def wall_contacts(self, compute_id: str = "walls") -> Contacts:
-        """Particle-wall contacts now; ``j`` is 0 and ``vj`` the wall's velocity (0 for a
-        fixed wall)."""
-        return self._contacts(self.local_array(compute_id))
-
-    @staticmethod
-    def _contacts(a: np.ndarray) -> Contacts:
-        if a.shape[1] != 11:
-            raise LiggghtsError(f"contact compute has {a.shape[1]} columns, expected 11: "
-                                "define it with add_pair_contacts()/add_wall_contacts()")
+        a = self._contact_array(compute_id)
         return Contacts(i=a[:, 6].astype(np.int64), j=a[:, 7].astype(np.int64),
                         delta=a[:, 10], vi=a[:, 0:3], vj=a[:, 3:6], area=a[:, 9])
 
+    def wall_contacts(self, compute_id: str = "walls") -> Contacts:
+        """Particle-mesh-wall contacts now: ``i`` the atom id, ``j`` the wall's index in
+        its fix (from 0), ``vi`` the particle's and ``vj`` the wall's velocity (m/s)."""
+        a = self._contact_array(compute_id)
+        # LIGGGHTS' order for walls: wall velocity, particle velocity; wall, atom, triangle.
+        return Contacts(i=a[:, 7].astype(np.int64), j=a[:, 6].astype(np.int64),
+                        delta=a[:, 10], vi=a[:, 3:6], vj=a[:, 0:3], area=a[:, 9])
+
+    def plane_contacts(self, axis: int, position: float, wall: int = 0) -> Contacts:
+        """Contacts with a fixed primitive plane wall ``axis`` = ``position`` (axis 0, 1, 2
+        for x, y, z; m), from geometry: overlap radius - distance (m), area pi (r delta)
+        to first order (m^2); ``j`` is ``wall``, ``vj`` zero."""
+        x, r, v = self.atom("x"), self.atom("radius"), self.atom("v")
+        delta = r - np.abs(x[:, axis] - position)
+        on = delta > 0
+        return Contacts(i=self.atom("id")[on].astype(np.int64), j=np.full(on.sum(), wall),
+                        delta=delta[on], vi=v[on].copy(), vj=np.zeros((on.sum(), 3)),
+                        area=np.pi * r[on] * delta[on])
+
+    def _contact_array(self, compute_id: str) -> np.ndarray:
+        a = self.local_array(compute_id)
+        if a.shape[1] != 11:
+            raise LiggghtsError(f"contact compute '{compute_id}' has {a.shape[1]} columns, not "
+                                "11: define it with add_pair_contacts()/add_wall_contacts()")
+        return a
+
     def close(self) -> None:
         if self.ptr:
+            self.helper.collheat_watch_exit(None, b"")
             self.lib.lammps_close(self.ptr)
             self.ptr = _vp()
         if self._tmp is not None:

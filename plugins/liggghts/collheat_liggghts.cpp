@@ -1,6 +1,7 @@
 // What LIGGGHTS 3.8's C library interface lacks, for pyhost/liggghts.py:
 // the size of a local compute (its row count is not in the C API), the force array of a
-// `fix external pf/array`, and a report of LIGGGHTS' last error when it ends the process.
+// `fix external pf/array`, and a report of LIGGGHTS' last error when it ends the process
+// (through exit or MPI_Abort).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -14,9 +15,11 @@
 using namespace LAMMPS_NS;
 
 static char exit_log[4096] = "";
+static LAMMPS *watched = nullptr;
 
 // On exit(1) from Error::all/one, print LIGGGHTS' ERROR line to stderr: the screen output
-// goes to a log file, so without this the process would end without a word.
+// goes to a log file, so without this the process would end without a word. Only when the
+// log ends with that line (LIGGGHTS writes nothing after it), so not on a normal exit.
 static void report_exit()
 {
     if (!exit_log[0]) return;
@@ -24,16 +27,27 @@ static void report_exit()
     if (!f) return;
     char line[4096], last[4096] = "";
     while (std::fgets(line, sizeof line, f))
-        if (std::strncmp(line, "ERROR", 5) == 0) std::strcpy(last, line);
+        if (line[0] != '\n') std::strcpy(last, line);
     std::fclose(f);
-    if (last[0]) std::fprintf(stderr, "LIGGGHTS ended the process: %s(log: %s)\n", last, exit_log);
+    if (std::strncmp(last, "ERROR", 5) == 0)
+        std::fprintf(stderr, "LIGGGHTS ended the process: %s(log: %s)\n", last, exit_log);
 }
 
 extern "C" {
 
-void collheat_watch_exit(const char *logfile)
+// Error::one ends with MPI_Abort, which skips atexit: this definition, found before
+// OpenMPI's because pyhost.liggghts loads this library first, reports and then aborts.
+int MPI_Abort(MPI_Comm comm, int code)
+{
+    if (watched && watched->screen) std::fflush(watched->screen);  // Error::one does not
+    report_exit();
+    return PMPI_Abort(comm, code);
+}
+
+void collheat_watch_exit(void *ptr, const char *logfile)
 {
     static bool registered = false;
+    watched = static_cast<LAMMPS *>(ptr);
     std::snprintf(exit_log, sizeof exit_log, "%s", logfile ? logfile : "");
     if (!registered) { std::atexit(report_exit); registered = true; }
 }
@@ -44,6 +58,17 @@ void collheat_flush(void *ptr)
     LAMMPS *lmp = static_cast<LAMMPS *>(ptr);
     if (lmp->screen) std::fflush(lmp->screen);
     if (lmp->logfile) std::fflush(lmp->logfile);
+}
+
+// Send LIGGGHTS' screen output to another file from now on (for a forked copy: the
+// parent's stream is left alone, its buffer was flushed before the fork).
+int collheat_set_screen(void *ptr, const char *path)
+{
+    LAMMPS *lmp = static_cast<LAMMPS *>(ptr);
+    FILE *f = std::fopen(path, "w");
+    if (!f) return -1;
+    lmp->screen = f;
+    return 0;
 }
 
 // Rows and columns of a local compute, evaluated on the current step; its data pointer.

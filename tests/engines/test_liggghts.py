@@ -1,6 +1,8 @@
 """LIGGGHTS bridge on the real engine: two 2 mm glass-like spheres meeting head-on."""
 import math
-import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -32,11 +34,13 @@ def two_spheres(workdir) -> Liggghts:
     return lg
 
 
-def hertz_contact_time(v_rel: float) -> float:
-    """Duration (s) of an elastic Hertz impact of two equal spheres (Johnson 1985, eq. 11.24)."""
-    m_eff = 0.5 * RHO * 4 / 3 * math.pi * R**3
+def hertz_contact_time(v_rel: float, wall: bool = False) -> float:
+    """Duration (s) of an elastic Hertz impact of two equal spheres, or of one sphere on a
+    wall of the same material (Johnson 1985, eq. 11.24)."""
+    m_eff = RHO * 4 / 3 * math.pi * R**3 * (1.0 if wall else 0.5)
+    r_eff = R if wall else R / 2
     e_eff = E / (2 * (1 - NU**2))
-    return 2.8683 * (m_eff**2 / ((R / 2) * e_eff**2 * v_rel)) ** 0.2
+    return 2.8683 * (m_eff**2 / (r_eff * e_eff**2 * v_rel)) ** 0.2
 
 
 def test_contact_list_shows_the_pair_for_the_hertz_duration(tmp_path):
@@ -56,6 +60,64 @@ def test_contact_list_shows_the_pair_for_the_hertz_duration(tmp_path):
         assert abs(steps_in_contact - expected) <= 0.01 * expected + 1
         # The spheres rebound with their speed (e = 1): momentum and energy kept to 1e-3.
         assert np.allclose(lg.atom("v")[:, 0], [-V, V], rtol=1e-3)
+
+
+STL_PLANE = """solid plane
+facet normal 0 0 1
+outer loop
+vertex -0.01 -0.01 {z}
+vertex 0.01 -0.01 {z}
+vertex 0.01 0.01 {z}
+endloop
+endfacet
+facet normal 0 0 1
+outer loop
+vertex -0.01 -0.01 {z}
+vertex 0.01 0.01 {z}
+vertex -0.01 0.01 {z}
+endloop
+endfacet
+endsolid plane
+"""
+
+
+@pytest.mark.parametrize("wall", ["mesh", "plane"])
+def test_wall_contact_list_shows_the_sphere_for_the_hertz_duration(tmp_path, wall):
+    """One sphere (1 m/s normal, 0.1 m/s tangential) onto a plane at z = -5 mm, as a mesh
+    wall (compute wall/gran/local) and as a primitive plane (geometry)."""
+    z_wall = -0.005
+    with Liggghts(tmp_path) as lg:
+        lg.commands(granular_box((-0.01,) * 3, (0.01,) * 3, youngs=E, poisson=NU,
+                                 restitution=1.0, friction=0.5, skin=R / 2, dt=DT))
+        if wall == "mesh":
+            (tmp_path / "plane.stl").write_text(STL_PLANE.format(z=z_wall))
+            lg.command(f"fix cad all mesh/surface file {tmp_path / 'plane.stl'} type 1")
+            lg.command("fix wall all wall/gran model hertz tangential history mesh "
+                       "n_meshes 1 meshes cad")
+        else:
+            lg.command("fix wall all wall/gran model hertz tangential history primitive "
+                       f"type 1 zplane {z_wall}")
+        lg.commands(f"""
+            create_atoms 1 single 0.001 0.002 {z_wall + 1.5 * R} units box
+            set atom 1 diameter {2 * R} density {RHO} vx 0.1 vz {-V}
+            fix integrate all nve/sphere
+        """)
+        if wall == "mesh":
+            lg.add_wall_contacts()
+        lg.run(0)
+        steps_in_contact = 0
+        for _ in range(1500):
+            lg.run(1)
+            c = lg.wall_contacts() if wall == "mesh" else lg.plane_contacts(2, z_wall)
+            steps_in_contact += len(c)
+            if len(c):
+                assert c.i.tolist() == [1] and c.j.tolist() == [0]
+                assert np.allclose(c.vi - c.vj, lg.atom("v"))
+                x = lg.atom("x")
+                assert c.delta[0] == pytest.approx(R - (x[0, 2] - z_wall), rel=1e-6, abs=1e-12)
+        expected = hertz_contact_time(V, wall=True) / DT
+        assert abs(steps_in_contact - expected) <= 0.01 * expected + 1
+        assert lg.atom("v")[0, 2] == pytest.approx(V, rel=1e-3)
 
 
 def test_temperatures_written_from_python_drive_the_next_steps(tmp_path):
@@ -85,6 +147,28 @@ def test_bad_command_raises_with_liggghts_message_and_host_survives(tmp_path):
             lg.command("fix f1 all bogus 1 2 3")
         with pytest.raises(LiggghtsError, match="ERROR"):
             lg.command("pair_coeff 7 7")
+        lg.command('fix p all print 20 "$${nothere}" screen no')   # fails at step 20
+        with pytest.raises(LiggghtsError, match="Substitution for illegal variable"):
+            lg.run(30)             # the first run after a command is tried (MPI_Abort here)
+        lg.command("unfix p")
         lg.run(10)                 # the instance is unharmed and still runs
         assert lg.step == 10
-        assert os.getpid() > 0
+
+
+def test_error_in_a_later_chunk_ends_the_process_with_liggghts_message(tmp_path):
+    """Chunks after the first are not tried: LIGGGHTS' message still reaches stderr."""
+    script = f"""
+from pyhost.liggghts import Liggghts, granular_box
+lg = Liggghts({str(tmp_path)!r})
+lg.commands(granular_box((-0.01,) * 3, (0.01,) * 3, youngs=5e6, poisson=0.3, restitution=1.0,
+                         friction=0.5, skin=5e-4, dt=1e-5))
+lg.commands(["create_atoms 1 single 0 0 0 units box", "set atom 1 diameter 0.002 density 2500",
+             "fix integrate all nve/sphere", 'fix p all print 20 "$${{nothere}}" screen no'])
+lg.run(1)
+lg.run(30)
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          cwd=Path(__file__).resolve().parents[2], timeout=60)
+    assert done.returncode != 0
+    assert ("LIGGGHTS ended the process: ERROR on proc 0: Substitution for illegal variable"
+            in done.stderr)
