@@ -18,7 +18,9 @@ from __future__ import annotations
 
 import ctypes
 import os
+import signal
 import tempfile
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable
@@ -210,7 +212,7 @@ class Liggghts:
                 self.helper.collheat_flush(self.ptr)
             finally:
                 os._exit(0)
-        _, status = os.waitpid(pid, 0)
+        status = self._wait_trial(pid, trial)
         if os.waitstatus_to_exitcode(status) != 0:
             text = trial.read_text(errors="replace") if trial.exists() else ""
             trial.unlink(missing_ok=True)
@@ -218,6 +220,25 @@ class Liggghts:
             message = errors[-1] if errors else (text.strip().splitlines() or ["no message"])[-1]
             raise LiggghtsError(f"LIGGGHTS refused '{what}': {message}")
         trial.unlink(missing_ok=True)
+
+    @staticmethod
+    def _wait_trial(pid: int, trial: Path) -> int:
+        """Wait for the copy. One that wrote an ERROR line and still lives a second later is
+        stuck in MPI_Finalize (MPI started by another LIGGGHTS user of this process, without
+        the isolated singleton): end it."""
+        errored_at, pause, start = None, 1e-4, time.monotonic()
+        while True:
+            done, status = os.waitpid(pid, os.WNOHANG)
+            if done:
+                return status
+            if (errored_at is None and time.monotonic() - start > 0.5 and trial.exists()
+                    and "\nERROR" in "\n" + trial.read_text(errors="replace")):
+                errored_at = time.monotonic()
+            if errored_at is not None and time.monotonic() - errored_at > 1.0:
+                os.kill(pid, signal.SIGKILL)
+                return os.waitpid(pid, 0)[1]
+            time.sleep(pause)
+            pause = min(2 * pause, 0.05)
 
     # -- per-atom data ----------------------------------------------------------------
     @property

@@ -64,19 +64,29 @@ if [ ! -f "$foam_src/.collheat-ready" ]; then
     $sudo touch "$foam_src/.collheat-ready"
 fi
 
-# The project's compiled extensions, rebuilt when their sources change.
+# The project's compiled extensions, each rebuilt when its sources change.
 mkdir -p "$out/bin" "$out/lib"
-stamp=$out/.build-stamp
-want=$(cd "$top" && find plugins/openfoam plugins/liggghts -type f \
-         ! -path '*/Make/linux*' ! -path '*/lnInclude/*' ! -name '*.so' -print0 \
-       | sort -z | xargs -0 sha256sum | sha256sum | cut -d' ' -f1)
-if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ] || [ ! -x "$out/bin/collheatFoam" ] \
-        || [ ! -f "$out/lib/libcollheat_liggghts.so" ]; then
+changed() {  # changed NAME DIR RESULT: true when DIR's sources differ from the last build
+    local stamp=$out/.$1.stamp
+    local want
+    want=$(find "$2" -type f ! -path '*/Make/linux*' ! -path '*/lnInclude/*' -print0 \
+           | sort -z | xargs -0 sha256sum | sha256sum | cut -d' ' -f1)
+    [ "$(cat "$stamp" 2>/dev/null)" != "$want" ] || [ ! -e "$3" ] || return 1
+    echo "$want" > "$stamp.new"
+}
+done_build() { mv "$out/.$1.stamp.new" "$out/.$1.stamp"; }
+
+helper=$out/lib/libcollheat_liggghts.so
+if changed liggghts plugins/liggghts "$helper"; then
     echo "setup_engines: compiling plugins/liggghts"
     g++ -O2 -fPIC -shared -DOMPI_SKIP_MPICXX -I/usr/include/liggghts \
         $(pkg-config --cflags ompi 2>/dev/null || echo -I/usr/lib/x86_64-linux-gnu/openmpi/include) \
-        plugins/liggghts/collheat_liggghts.cpp -o "$out/lib/libcollheat_liggghts.so" \
-        -Wl,--no-as-needed -lliggghts
+        plugins/liggghts/collheat_liggghts.cpp -o "$helper" -Wl,--no-as-needed -lliggghts -lmpi
+    done_build liggghts
+fi
+
+solver=$out/bin/collheatFoam
+if changed openfoam plugins/openfoam "$solver"; then
     echo "setup_engines: compiling plugins/openfoam/collheatFoam (about 30 s)"
     (
         set +eu
@@ -87,6 +97,6 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ] || [ ! -x "$out/bin/collheatFoam
         cd plugins/openfoam/collheatFoam
         wmake > "$out/log.wmake" 2>&1 || { tail -30 "$out/log.wmake" >&2; exit 1; }
     )
-    echo "$want" > "$stamp"
+    done_build openfoam
 fi
-echo "setup_engines: ready (solver $out/bin/collheatFoam, helper $out/lib/libcollheat_liggghts.so)"
+echo "setup_engines: ready (solver $solver, helper $helper)"
