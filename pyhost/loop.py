@@ -73,6 +73,7 @@ class Coupling:
         return self.finish()
 
     def sample_contacts(self, dt_sample: float) -> None:
+        self.dt_sample = dt_sample
         x, v = self.dem.state()
         c = self.contacts(x, v)
         keys = contact_keys(c.i, c.j)
@@ -111,7 +112,8 @@ class Coupling:
         v0 = np.empty(len(rows))
         for (a, b), law in self.dem_laws(mi, mj).items():
             s = (mi == a) & (mj == b)
-            v0[s] = law.impact_speed(c.delta[rows][s], c.approach[rows][s], R_eff[s], m_eff[s])
+            v0[s] = law.impact_speed(c.delta[rows][s], c.approach[rows][s], R_eff[s], m_eff[s],
+                                     window=self.dt_sample)
         model = self.scene.effects.contact_heat
         Q = e = t_coll = np.zeros(len(rows))
         if model != "none":

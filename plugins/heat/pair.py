@@ -72,10 +72,9 @@ class Pair:
         positive = ("R1", "rho1", "rho2", "Estar", "Y", "b1", "b2", "c1", "c2", "k1", "k2")
         for name in positive + ("R2",):
             value = np.asarray(getattr(self, name), dtype=float)
-            if np.any(np.isnan(value)) or np.any(value <= 0):
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
-            if name != "R2" and np.any(np.isinf(value)):
-                raise ValueError(f"{name} must be finite, got {getattr(self, name)!r}")
+            if not np.all(value > 0) or (name != "R2" and not np.all(value < np.inf)):
+                raise ValueError(f"{name} must be positive and finite{' (or inf)' if name == 'R2' else ''}, "
+                                 f"got {getattr(self, name)!r}")
         if not np.all(np.isfinite(np.asarray(self.dT, dtype=float))):
             raise ValueError(f"dT must be finite, got {self.dT!r}")
         if np.any(np.asarray(self.b2) <= np.asarray(self.b1)):
