@@ -16,6 +16,7 @@ ends. Units are whatever the input sets; the project uses ``units si`` (m, kg, s
 """
 from __future__ import annotations
 
+import atexit
 import ctypes
 import os
 import signal
@@ -156,6 +157,8 @@ class Liggghts:
             else:
                 os.environ[_ISOLATED] = saved
         self.helper.collheat_watch_exit(self.ptr, str(self.log).encode())
+        # Python's own exit runs this first: the helper then stays quiet.
+        atexit.register(self.helper.collheat_watch_exit, None, b"")
         self._changed = True  # a command since the last run: try the next run first
 
     # -- commands ---------------------------------------------------------------------

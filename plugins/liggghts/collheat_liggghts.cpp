@@ -17,9 +17,9 @@ using namespace LAMMPS_NS;
 static char exit_log[4096] = "";
 static LAMMPS *watched = nullptr;
 
-// On exit(1) from Error::all/one, print LIGGGHTS' ERROR line to stderr: the screen output
-// goes to a log file, so without this the process would end without a word. Only when the
-// log ends with that line (LIGGGHTS writes nothing after it), so not on a normal exit.
+// On exit(1) from Error::all, or MPI_Abort from Error::one, print LIGGGHTS' last ERROR line
+// to stderr: the screen output goes to a log file, so without this the process would end
+// without a word. pyhost.liggghts disarms it on a normal exit of Python.
 static void report_exit()
 {
     if (!exit_log[0]) return;
@@ -27,9 +27,9 @@ static void report_exit()
     if (!f) return;
     char line[4096], last[4096] = "";
     while (std::fgets(line, sizeof line, f))
-        if (line[0] != '\n') std::strcpy(last, line);
+        if (std::strncmp(line, "ERROR", 5) == 0) std::strcpy(last, line);
     std::fclose(f);
-    if (std::strncmp(last, "ERROR", 5) == 0)
+    if (last[0])
         std::fprintf(stderr, "LIGGGHTS ended the process: %s(log: %s)\n", last, exit_log);
 }
 
