@@ -160,27 +160,30 @@ class ContactTracker:
         return opened, closed
 
 
-def exchange_heat(T, C, i, j, Q, T_wall=None):
-    """Move heat Q [J] (> 0 from i to j) between bodies, one collision after the other.
+def exchange_heat(T, C, i, j, G, T_wall=None):
+    """Move heat between bodies, one collision after the other, with the temperatures of that
+    moment: q = G (T_i - T_j) [J] from i to j, G [J/K] the collision's conductance-time
+    (the plugin's Q per kelvin: Q is linear in dT, eqs. 2-3).
 
     T [K] and C = m c [J/K] are per particle; j >= WALL_BASE is wall j - WALL_BASE, with
     temperature T_wall[wall] (None or NaN: adiabatic, no exchange). No collision carries more
-    heat than would equalise the two temperatures: such a Q is capped. Returns the heat
-    actually moved per collision, the number capped, and the heat that entered the
-    particles from walls [J]. sum(C T) changes by exactly that wall heat (to rounding).
+    heat than would equalise the two temperatures: a G above C_i C_j/(C_i + C_j) (C_i for a
+    wall) is capped there. Returns the heat moved per collision [J], the number capped, and
+    the heat that entered the particles from walls [J]; sum(C T) changes by exactly that.
     """
-    moved = np.zeros(len(Q))
+    moved = np.zeros(len(G))
     capped, from_walls = 0, 0.0
-    for k, (a, b, q) in enumerate(zip(np.asarray(i), np.asarray(j), np.asarray(Q, float))):
+    for k, (a, b, g) in enumerate(zip(np.asarray(i), np.asarray(j), np.asarray(G, float))):
         if b >= WALL_BASE:
             tw = np.nan if T_wall is None else T_wall[b - WALL_BASE]
             if np.isnan(tw):
                 continue
-            limit = (T[a] - tw) * C[a]
+            limit, dT = C[a], T[a] - tw
         else:
-            limit = (T[a] - T[b]) * C[a] * C[b] / (C[a] + C[b])
-        if abs(q) > abs(limit) or q * limit < 0:
-            q, capped = (limit if q * limit > 0 else 0.0), capped + 1
+            limit, dT = C[a] * C[b] / (C[a] + C[b]), T[a] - T[b]
+        if g > limit:
+            g, capped = limit, capped + 1
+        q = g * dT
         T[a] -= q / C[a]
         if b >= WALL_BASE:
             from_walls -= q

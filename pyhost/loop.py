@@ -86,13 +86,12 @@ class Coupling:
             self.conduct_enduring(c, keys, dt_sample)
 
     def partner_arrays(self, i, j):
-        """Material index, radius [m], mass [kg] and temperature [K] of each partner j."""
+        """Whether each partner j is a wall, and its material index, radius [m], mass [kg]."""
         wall = j >= WALL_BASE
         jj = np.where(wall, 0, j)
         w = np.where(wall, j - WALL_BASE, 0)
         mat = np.where(wall, self.wall_material[w] if len(self.wall_material) else 0, self.p.material[jj])
-        T_j = np.where(wall, self.T_wall[w] if len(self.T_wall) else np.nan, self.T[jj])
-        return wall, mat, np.where(wall, np.inf, self.p.radius[jj]), np.where(wall, np.inf, self.p.mass[jj]), T_j
+        return wall, mat, np.where(wall, np.inf, self.p.radius[jj]), np.where(wall, np.inf, self.p.mass[jj])
 
     def dem_laws(self, mi, mj):
         """The DEM's contact law for each material pair (LIGGGHTS' effective modulus)."""
@@ -105,7 +104,7 @@ class Coupling:
 
     def start_collisions(self, c, keys, rows) -> None:
         i, j = c.i[rows], c.j[rows]
-        wall, mj, R_j, m_j, T_j = self.partner_arrays(i, j)
+        wall, mj, R_j, m_j = self.partner_arrays(i, j)
         mi, R_i, m_i = self.p.material[i], self.p.radius[i], self.p.mass[i]
         R_eff = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
         m_eff = np.where(wall, m_i, m_i * m_j / np.where(wall, 1.0, m_i + m_j))
@@ -115,21 +114,20 @@ class Coupling:
             v0[s] = law.impact_speed(c.delta[rows][s], c.approach[rows][s], R_eff[s], m_eff[s],
                                      window=self.dt_sample)
         model = self.scene.effects.contact_heat
-        Q = e = t_coll = np.zeros(len(rows))
+        moved = e = t_coll = np.zeros(len(rows))
         if model != "none":
-            dT = np.where(np.isnan(T_j), 0.0, self.T[i] - np.nan_to_num(T_j))
-            Q, e, t_coll = evaluate(model, self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0, dT)
-            moved, capped, from_walls = exchange_heat(self.T, self.C, i, j, Q, self.T_wall)
+            G, e, t_coll = evaluate(model, self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0,
+                                    np.ones(len(rows)))                        # Q per kelvin [J/K]
+            moved, capped, from_walls = exchange_heat(self.T, self.C, i, j, G, self.T_wall)
             self.totals["capped"] += capped
             self.totals["heat_from_walls"] += from_walls
             self.totals["heat_moved"] += float(np.abs(moved[~wall]).sum())
-            Q = moved
         for k, key in enumerate(keys[rows]):
             self.open[int(key)] = (self.t, t_coll[k], e[k], v0[k])
         self.totals["collisions"] += len(rows)
         self.totals["wall_collisions"] += int(wall.sum())
         self.collisions.write_columns(time=np.full(len(rows), self.t), i=i + 1, j=np.where(wall, 0, j + 1),
-                                      wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0, Q=Q, e=e,
+                                      wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
                                       t_coll=t_coll, model=np.full(len(rows), model))
 
     def end_collisions(self, closed, x, v) -> None:
@@ -138,7 +136,7 @@ class Coupling:
             return
         i = (closed >> 31).astype(int)
         j = (closed & ((1 << 31) - 1)).astype(int)
-        wall, _, _, m_j, _ = self.partner_arrays(i, j)
+        wall, _, _, m_j = self.partner_arrays(i, j)
         jj = np.where(wall, 0, j)
         normal = np.zeros((len(i), 3))
         for k in np.flatnonzero(wall):
@@ -164,15 +162,14 @@ class Coupling:
         if not len(rows):
             return
         i, j = c.i[rows], c.j[rows]
-        wall, mj, R_j, _, T_j = self.partner_arrays(i, j)
+        wall, mj, R_j, _ = self.partner_arrays(i, j)
         k_i = np.array([m.conductivity for m in self.materials])[self.p.material[i]]
         k_j = np.array([m.conductivity for m in self.materials])[mj]
         R_i = self.p.radius[i]
         R_eff = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
         h = 4 * k_i * k_j / (k_i + k_j) * np.sqrt(np.pi * R_eff * c.delta[rows])
-        dT = np.where(np.isnan(T_j), 0.0, self.T[i] - np.nan_to_num(T_j))
-        Q = h * dT * np.minimum(age[rows], dt_sample)
-        moved, capped, from_walls = exchange_heat(self.T, self.C, i, j, Q, self.T_wall)
+        moved, capped, from_walls = exchange_heat(self.T, self.C, i, j, h * np.minimum(age[rows], dt_sample),
+                                                  self.T_wall)
         self.totals["enduring_heat"] += float(np.abs(moved).sum())
         self.totals["heat_from_walls"] += from_walls
         self.totals["capped"] += capped

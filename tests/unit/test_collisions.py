@@ -76,13 +76,21 @@ def test_heat_exchange_conserves_and_caps():
     i, j = rng.integers(0, 50, 400), rng.integers(0, 50, 400)
     keep = i != j
     i, j = i[keep], j[keep]
-    Q = (T[i] - T[j]) * rng.uniform(0, 0.2, i.size) * 1e-2      # sized to cap some
-    Q[::7] *= 1e4
+    G = rng.uniform(0, 1e-3, i.size)
+    G[::7] = 10.0                                    # more than equalisation: capped
     total = np.sum(C * T)
-    moved, capped, from_walls = exchange_heat(T, C, i, j, Q)
-    assert from_walls == 0.0 and capped > 0
+    moved, capped, from_walls = exchange_heat(T, C, i, j, G)
+    assert from_walls == 0.0 and capped == len(G[::7])
     assert np.sum(C * T) == pytest.approx(total, rel=1e-12)
     assert T.min() >= 300 - 1e-9 and T.max() <= 400 + 1e-9     # capping never overshoots
+
+
+def test_heat_flows_with_the_temperatures_of_the_moment():
+    # particle 1 first meets the cold 2, then the hot 0: the second exchange sees its new T
+    T, C = np.array([400.0, 400.0, 300.0]), np.ones(3)
+    moved, capped, _ = exchange_heat(T, C, np.array([1, 1]), np.array([2, 0]), np.array([0.5, 0.5]))
+    assert capped == 0 and moved[0] == pytest.approx(50.0) and moved[1] == pytest.approx(-25.0)
+    assert T == pytest.approx([375.0, 375.0, 350.0])
 
 
 def test_heat_exchange_with_walls_balances():
@@ -92,26 +100,10 @@ def test_heat_exchange_with_walls_balances():
     i = np.array([0, 1, 0])
     j = np.array([WALL_BASE, WALL_BASE, WALL_BASE + 1])
     before = np.sum(C * T)
-    moved, capped, from_walls = exchange_heat(T, C, i, j, np.array([0.1, -0.05, 1.0]), T_wall)
+    moved, capped, from_walls = exchange_heat(T, C, i, j, np.array([0.1 / 30, 0.05 / 20, 1.0]), T_wall)
     assert moved[2] == 0.0                       # adiabatic wall
     assert np.sum(C * T) - before == pytest.approx(from_walls, rel=1e-12)
     assert T[0] == pytest.approx(340.0) and T[1] == pytest.approx(302.5)
-    # a wall collision that would cool the particle below the wall is capped at the wall's temperature
+    # a conductance above the particle's heat capacity is capped: the particle reaches the wall's T
     _, capped, _ = exchange_heat(T, C, np.array([0]), np.array([WALL_BASE]), np.array([10.0]), T_wall)
     assert capped == 1 and T[0] == pytest.approx(320.0)
-
-
-@pytest.mark.parametrize("fraction", [0.45, 0.6, 0.9])
-def test_late_contacts_recovered_over_the_sample_window(fraction):
-    # vectorised backwards RK4 over the window since the previous sample
-    speeds = (0.01, 5.0)
-    d, dd, windows = [], [], []
-    for v0 in speeds:
-        sol = dem_collision(v0)
-        t = fraction * sol.t_events[0][0]
-        di, ddi = sol.sol(t)
-        d.append(di), dd.append(ddi), windows.append(t * 1.2)
-    for k, v0 in enumerate(speeds):
-        # RK4 steps across the delta^(1/4) damping term at touch: ~1e-4, far below what
-        # sampling that late costs anyway (~1e-2, tools/bench_host.py)
-        assert LAW.impact_speed(d[k], dd[k], R, M, window=windows[k])[()] == pytest.approx(v0, rel=5e-4)
