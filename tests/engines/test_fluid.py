@@ -2,6 +2,7 @@
 against two ranks, a diverging run."""
 import numpy as np
 import pytest
+from foamlib import FoamCase
 from scipy.optimize import brentq
 
 from pyhost import drag
@@ -83,6 +84,13 @@ def test_fixed_packed_bed_pressure_drop_matches_ergun(tmp_path, u_s):
         p, _ = fluid.fields()
         zc = fluid.cell_centres[:, 2]
         alpha = fluid.alpha
+        written = fluid.write()
+    # What the solver wrote, read back with foamlib, is what the pipe gave.
+    step = FoamCase(case)[-1]
+    assert step.time == pytest.approx(written)
+    assert np.allclose(np.asarray(step["p"].internal_field) * WATER["rho"], p, rtol=1e-8,
+                       atol=1e-8 * np.abs(p).max())
+    assert np.allclose(np.asarray(step["alpha"].internal_field), alpha, rtol=1e-8)
     inside = (zc > (bed[0] + 1) * cell) & (zc < (bed[-1]) * cell)
     assert np.allclose(alpha[inside], 1 - np.pi / 6, rtol=1e-12)
     slope = -np.polyfit(zc[inside], p[inside], 1)[0]    # Pa/m

@@ -55,6 +55,7 @@ def test_contact_list_shows_the_pair_for_the_hertz_duration(tmp_path):
             if len(c):
                 assert np.allclose(c.vi - c.vj, lg.atom("v")[0] - lg.atom("v")[1])
         expected = hertz_contact_time(2 * V) / DT
+        print(f"pair contact: {steps_in_contact} steps, Hertz {expected:.1f}")
         assert pairs == {(1, 2)}
         # Hertz with e = 1; the count is a whole number of steps: 1 % plus one step.
         assert abs(steps_in_contact - expected) <= 0.01 * expected + 1
@@ -116,6 +117,7 @@ def test_wall_contact_list_shows_the_sphere_for_the_hertz_duration(tmp_path, wal
                 x = lg.atom("x")
                 assert c.delta[0] == pytest.approx(R - (x[0, 2] - z_wall), rel=1e-6, abs=1e-12)
         expected = hertz_contact_time(V, wall=True) / DT
+        print(f"{wall} wall contact: {steps_in_contact} steps, Hertz {expected:.1f}")
         assert abs(steps_in_contact - expected) <= 0.01 * expected + 1
         assert lg.atom("v")[0, 2] == pytest.approx(V, rel=1e-3)
 
@@ -138,7 +140,8 @@ def test_temperatures_written_from_python_drive_the_next_steps(tmp_path):
         t1, t2 = lg.temperature()
         assert t1 + t2 == pytest.approx(700.0, abs=1e-9)     # heat is conserved
         assert 400.0 - t1 > 1e-3                               # and some was conducted
-        assert (400.0 - t1) * m * C == pytest.approx(h_sum, rel=0.02)
+        print(f"heat conducted {(400.0 - t1) * m * C:.4e} J, from the contact list {h_sum:.4e} J")
+        assert (400.0 - t1) * m * C == pytest.approx(h_sum, rel=1e-3)
 
 
 def test_bad_command_raises_with_liggghts_message_and_host_survives(tmp_path):
