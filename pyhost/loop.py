@@ -60,16 +60,20 @@ class Coupling:
         sample = tm.sample_every if self.effects["contact_extraction"] else n_end
         frame = max(1, round(self.scene.output.every / tm.dem_step))
         self.write_frame()
-        while self.step < n_end:
-            n = min(sample - self.step % sample, frame - self.step % frame, n_end - self.step)
-            self.dem.run(n)
-            self.step += n
-            self.t = self.step * tm.dem_step
-            if self.effects["contact_extraction"] and self.step % sample == 0:
-                self.sample_contacts(sample * tm.dem_step)
-            if self.step % frame == 0 or self.step == n_end:
-                self.write_frame()
-            self.progress.update(self.t, f", {self.totals['collisions']} collisions")
+        try:
+            while self.step < n_end:
+                n = min(sample - self.step % sample, frame - self.step % frame, n_end - self.step)
+                self.dem.run(n)
+                self.step += n
+                self.t = self.step * tm.dem_step
+                if self.effects["contact_extraction"] and self.step % sample == 0:
+                    self.sample_contacts(sample * tm.dem_step)
+                if self.step % frame == 0 or self.step == n_end:
+                    self.write_frame()
+                self.progress.update(self.t, f", {self.totals['collisions']} collisions")
+        except BaseException as exc:          # keep what was computed: summary of the run so far
+            self.finish(status=f"stopped at t = {self.t:g} s by {type(exc).__name__}: {exc}")
+            raise
         return self.finish()
 
     def sample_contacts(self, dt_sample: float) -> None:
@@ -185,10 +189,11 @@ class Coupling:
             self.frames.write(self.t, x, id=np.arange(1, len(x) + 1), radius=self.p.radius, velocity=v,
                               temperature=self.T)
 
-    def finish(self) -> dict:
+    def finish(self, status: str = "completed") -> dict:
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
         CT = float(np.sum(self.C * self.T))
-        summary = dict(self.totals, time=self.t, steps=self.step, sum_mcT_start=self.CT0, sum_mcT_end=CT,
+        summary = dict(self.totals, status=status, time=self.t, steps=self.step, sum_mcT_start=self.CT0,
+                       sum_mcT_end=CT,
                        energy_balance_error=(CT - self.CT0 - self.totals["heat_from_walls"]) / self.CT0)
         (self.out / "summary.json").write_text(json.dumps(summary, indent=1))
         self.collisions.close()

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.dem import Liggghts
+from pyhost.dem import SceneDem
 from pyhost.dem_input import input_lines, place_particles, write_data
 from pyhost.loop import Coupling
 from pyhost.scene import load_scene
@@ -40,7 +40,7 @@ def variant(scene, end, **effects):
 
 def run_host(scene, out: Path):
     particles = place_particles(scene)
-    dem = Liggghts(scene, particles, out / "dem")
+    dem = SceneDem(scene, particles, out / "dem")
     t = time.perf_counter()
     try:
         summary = Coupling(scene, dem, particles, out, progress_every=1e9).run()

@@ -25,7 +25,7 @@ def resolved(scene) -> dict:
 
 def run(args) -> int:
     from pyhost.cli import UserError
-    from pyhost.dem import Liggghts
+    from pyhost.dem import SceneDem
     from pyhost.dem_input import dem_collision_time, place_particles
     from pyhost.loop import Coupling
     from pyhost.scene import load_scene
@@ -47,7 +47,7 @@ def run(args) -> int:
     if scene.time.dem_step > t_c / 20:
         print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
               f"({t_c:.3g} s) with fewer than 20 steps")
-    dem = Liggghts(scene, particles, out / "dem")
+    dem = SceneDem(scene, particles, out / "dem")
     try:
         summary = Coupling(scene, dem, particles, out).run()
     finally:

@@ -74,3 +74,45 @@ def test_hot_cold_box_smoke_conserves_and_converges(tmp_path):
     assert hot == pytest.approx(-cold, rel=1e-6)          # equal heat capacities
     assert (tmp_path / "temperatures.png").stat().st_size > 10000
     assert (tmp_path / "particles.png").stat().st_size > 10000
+
+
+def test_engine_error_is_one_clear_message_and_exit_2(tmp_path):
+    text = (CASES / "two-particles" / "case.toml").read_text()
+    (tmp_path / "case.toml").write_text(text.replace("[[0.045, 0.005, 0.01]]", "[[0.5, 0.005, 0.01]]"))
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 2
+    assert "LiggghtsError" in r.stderr and "ERROR" in r.stderr and "Traceback" not in r.stderr
+
+
+class Interrupting:
+    """A DEM that fails after a few chunks, as an engine that diverges would."""
+
+    def __init__(self, dem, after):
+        self.dem, self.calls, self.after = dem, 0, after
+
+    def run(self, n):
+        self.calls += 1
+        if self.calls > self.after:
+            raise RuntimeError("diverged")
+        self.dem.run(n)
+
+    def __getattr__(self, name):
+        return getattr(self.dem, name)
+
+
+def test_results_so_far_survive_a_failure(tmp_path):
+    from pyhost.dem import SceneDem
+    from pyhost.dem_input import place_particles
+    from pyhost.loop import Coupling
+
+    scene = load_scene(CASES / "hot-cold-box" / "case.toml")
+    p = place_particles(scene)
+    dem = SceneDem(scene, p, tmp_path / "dem")
+    with pytest.raises(RuntimeError, match="diverged"):
+        Coupling(scene, Interrupting(dem, 300), p, tmp_path, progress_every=1e9).run()
+    dem.close()
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["status"].startswith("stopped at t = 0.003 s by RuntimeError: diverged")
+    rows = list(csv.DictReader(open(tmp_path / "collisions.csv")))
+    assert len(rows) == summary["collisions"] > 0
+    assert abs(summary["energy_balance_error"]) < 1e-12
