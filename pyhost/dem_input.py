@@ -58,15 +58,15 @@ def place_particles(scene: Scene, seed: int = 12345) -> Particles:
             pos = np.asarray(g.positions, float)
         else:
             lo, hi = np.array(g.region[0::2], float), np.array(g.region[1::2], float)
-            spacing = 2.1 * g.radius
-            n = np.floor((hi - lo - 2 * g.radius) / spacing).astype(int) + 1
+            spacing = 2.1 * g.radius                     # half a spacing from each face: the
+            n = np.floor((hi - lo - spacing) / spacing).astype(int) + 1   # jitter never reaches a wall
             if np.any(n < 1) or n.prod() < g.count:
                 raise SceneError(f"{scene.path}: particles[{k}].region: holds {max(int(n.prod()), 0)} "
                                  f"particles of radius {g.radius} m, not {g.count}")
             cells = np.stack(np.meshgrid(*(np.arange(m) for m in n), indexing="ij"), -1).reshape(-1, 3)
             cells = cells[np.argsort(cells[:, 2], kind="stable")][: g.count]   # fill from the bottom
             jitter = rng.uniform(-0.04, 0.04, cells.shape) * g.radius
-            pos = lo + g.radius + cells * spacing + jitter
+            pos = lo + 0.5 * spacing + cells * spacing + jitter
         vel = np.asarray(g.velocity, float) + rng.normal(0.0, 1.0, pos.shape) * g.velocity_spread
         parts.append((pos, vel, g))
     mats = scene.materials

@@ -4,7 +4,9 @@ The DEM is any object with
     run(steps)                      advance the particles by whole DEM steps,
     state() -> (x, v)               positions [m] and velocities [m/s], (N, 3), in particle order,
     add_velocity(index, dv)         change the velocities of some particles [m/s],
-and the loop builds only what the scene asks for (``Scene.effects_summary``): no contact
+    set_force(F)                    (fluid scenes) force on each particle [N] until changed,
+and the fluid, when the scene has one, a started ``pyhost.openfoam.FluidSolver``;
+the loop builds only what the scene asks for (``Scene.effects_summary``): no contact
 sampling for an isothermal scene without restitution feedback, no heat arrays without a
 heat model. Temperatures live in the host (``self.T``), which is the only place they change.
 How a contact is classified (collision, then enduring) is told in ``pyhost.collisions``.
@@ -29,8 +31,10 @@ COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model"
 class Coupling:
     """One run of a scene with a DEM engine; ``run()`` returns the summary it also writes."""
 
-    def __init__(self, scene, dem, particles: Particles, out: Path, progress_every: float = 5.0):
+    def __init__(self, scene, dem, particles: Particles, out: Path, progress_every: float = 5.0, fluid=None):
         self.scene, self.dem, self.p, self.out = scene, dem, particles, Path(out)
+        self.fluid = fluid              # a started pyhost.openfoam.FluidSolver, or None (dry)
+        self.fluid_frames = VtkSeries(self.out / "vtk", "fluid") if fluid is not None and scene.output.vtk else None
         self.effects = scene.effects_summary()
         self.materials = list(scene.materials.values())
         self.wall_material = np.array([material_index(scene)[w.material] for w in scene.walls], int)
@@ -59,15 +63,21 @@ class Coupling:
         n_end = round(tm.end / tm.dem_step)
         sample = tm.sample_every if self.effects["contact_extraction"] else n_end
         frame = max(1, round(self.scene.output.every / tm.dem_step))
-        self.write_frame()
+        couple = tm.couple_every if self.fluid is not None else n_end
         try:
+            if self.fluid is not None:
+                self.couple_fluid(couple * tm.dem_step)
+            self.write_frame()
             while self.step < n_end:
-                n = min(sample - self.step % sample, frame - self.step % frame, n_end - self.step)
+                n = min(sample - self.step % sample, frame - self.step % frame, couple - self.step % couple,
+                        n_end - self.step)
                 self.dem.run(n)
                 self.step += n
                 self.t = self.step * tm.dem_step
                 if self.effects["contact_extraction"] and self.step % sample == 0:
                     self.sample_contacts(sample * tm.dem_step)
+                if self.fluid is not None and self.step % couple == 0 and self.step < n_end:
+                    self.couple_fluid(couple * tm.dem_step)
                 if self.step % frame == 0 or self.step == n_end:
                     self.write_frame()
                 self.progress.update(self.t, f", {self.totals['collisions']} collisions")
@@ -75,6 +85,12 @@ class Coupling:
             self.finish(status=f"stopped at t = {self.t:g} s by {type(exc).__name__}: {exc}")
             raise
         return self.finish()
+
+    def couple_fluid(self, duration: float) -> None:
+        """The fluid's force on each particle from the current fluid, then the fluid advanced
+        over the next coupling interval with these particles' fraction and drag."""
+        x, v = self.dem.state()
+        self.dem.set_force(self.fluid.couple(x, v, 2.0 * self.p.radius, duration))
 
     def sample_contacts(self, dt_sample: float) -> None:
         self.dt_sample = dt_sample
@@ -188,6 +204,9 @@ class Coupling:
             x, v = self.dem.state()
             self.frames.write(self.t, x, id=np.arange(1, len(x) + 1), radius=self.p.radius, velocity=v,
                               temperature=self.T)
+        if self.fluid_frames is not None:
+            p, u = self.fluid.fields()
+            self.fluid_frames.write(self.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)
 
     def finish(self, status: str = "completed") -> dict:
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)

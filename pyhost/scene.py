@@ -137,9 +137,11 @@ class Domain:
 class Fluid:
     density: float = spec(">0", 1.2, "[kg/m^3]")
     viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
-    inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the bottom [m/s]")
-    drag: str = spec("", "DiFelice", "drag law (pyhost.drag)")
+    inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the bottom (z lo) [m/s]")
+    drag: str = spec("in:difelice,gidaspow,ergun,wenyu", "gidaspow", "drag law (pyhost.drag)")
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
+    sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")
+    alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]")
 
 
 @dataclass(frozen=True)
@@ -276,5 +278,7 @@ def load_scene(path) -> Scene:
         raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model in effects.contact_heat")
     if effects.fluid and fluid is None:
         raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
+    if fluid is not None and (len(fluid.cells) != 3 or not all(isinstance(n, int) and n > 0 for n in fluid.cells)):
+        raise SceneError(f"{file}: fluid.cells: must be 3 positive integers, got {fluid.cells!r}")
     output = _build(Output, data.get("output", {}), "output", file)
     return Scene(path, effects, materials, particles, domain, time, walls, fluid, output)

@@ -23,8 +23,22 @@ def resolved(scene) -> dict:
     return d
 
 
+def start_fluid(scene, folder: Path):
+    """The scene's fluid: a box case (pyhost.fluid_case) with the inlet at z lo and the
+    outlet at z hi, solved by collheatFoam, coupled every time.couple_every DEM steps."""
+    from pyhost.fluid_case import box_case
+    from pyhost.openfoam import FluidSolver
+
+    f, box = scene.fluid, scene.domain.box
+    boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
+    boundaries.update(zlo=("inlet", (0.0, 0.0, f.inlet_velocity)), zhi="outlet")
+    case = box_case(folder, lo=box[0::2], hi=box[1::2], cells=f.cells, boundaries=boundaries, rho=f.density,
+                    nu=f.viscosity / f.density, gravity=scene.domain.gravity,
+                    dt=scene.time.couple_every * scene.time.dem_step)
+    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min).start()
+
+
 def run(args) -> int:
-    from pyhost.cli import UserError
     from pyhost.dem import SceneDem
     from pyhost.dem_input import dem_collision_time, place_particles
     from pyhost.loop import Coupling
@@ -35,8 +49,6 @@ def run(args) -> int:
         end = scene.time.test_end or scene.time.end / 10
         scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=end))
     effects = scene.effects_summary()
-    if effects["fluid_solver"]:
-        raise UserError(f"{scene.path}: effects.fluid: the fluid coupling is not wired into the host yet")
     out = args.out or args.case / "output"
     out.mkdir(parents=True, exist_ok=True)
     print("scene:", json.dumps(resolved(scene), indent=1, default=str))
@@ -47,11 +59,16 @@ def run(args) -> int:
     if scene.time.dem_step > t_c / 20:
         print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
               f"({t_c:.3g} s) with fewer than 20 steps")
-    dem = SceneDem(scene, particles, out / "dem")
+    fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None
     try:
-        summary = Coupling(scene, dem, particles, out).run()
+        dem = SceneDem(scene, particles, out / "dem", fluid_force=fluid is not None)
+        try:
+            summary = Coupling(scene, dem, particles, out, fluid=fluid).run()
+        finally:
+            dem.close()
     finally:
-        dem.close()
+        if fluid is not None:
+            fluid.stop()
     print("summary:", json.dumps(summary, indent=1))
     if scene.output.pictures:        # own process: see pyhost/commands/pictures.py
         drawn = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(out)])

@@ -100,3 +100,11 @@ def test_region_too_small_is_reported(tmp_path):
     (tmp_path / "case.toml").write_text(BED.format(e=0.5).replace("count = 60", "count = 600"))
     with pytest.raises(SceneError, match=r"particles\[0\].region: holds"):
         place_particles(load_scene(tmp_path / "case.toml"))
+
+
+def test_lattice_keeps_clear_of_the_region_faces(tmp_path):
+    (tmp_path / "case.toml").write_text(BED.format(e=0.5))
+    scene = load_scene(tmp_path / "case.toml")
+    p = place_particles(scene)
+    lo, hi = np.array(scene.particles[0].region[0::2]), np.array(scene.particles[0].region[1::2])
+    assert np.all(p.position - p.radius[:, None] > lo) and np.all(p.position + p.radius[:, None] < hi)
