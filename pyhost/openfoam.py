@@ -153,7 +153,11 @@ class FluidSolver:
             shutil.rmtree(self.case / ".link", ignore_errors=True)
 
     def __enter__(self) -> "FluidSolver":
-        return self.start()
+        try:
+            return self.start()
+        except BaseException:
+            self.stop()
+            raise
 
     def __exit__(self, *exc) -> None:
         self.stop()
