@@ -137,7 +137,9 @@ class Domain:
 class Fluid:
     density: float = spec(">0", 1.2, "[kg/m^3]")
     viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
-    inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the bottom (z lo) [m/s]")
+    inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the inlet (fluid z lo) [m/s]")
+    plenum: float = spec(">=0", 0.0, "particle-free fluid layer below the box [m]: the box's z lo "
+                                      "wall is then a distributor, and the inlet sees no particles")
     drag: str = spec("in:difelice,gidaspow,ergun,wenyu", "gidaspow", "drag law (pyhost.drag)")
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
     sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")

@@ -24,15 +24,18 @@ def resolved(scene) -> dict:
 
 
 def start_fluid(scene, folder: Path):
-    """The scene's fluid: a box case (pyhost.fluid_case) with the inlet at z lo and the
-    outlet at z hi, solved by collheatFoam, coupled every time.couple_every DEM steps."""
+    """The scene's fluid: a box case (pyhost.fluid_case) over the domain and the plenum below
+    it, inlet at its z lo, outlet at z hi, solved by collheatFoam every time.couple_every DEM
+    steps. The inlet value is the fluid velocity there, so the superficial velocity asked for
+    needs a particle-free inlet (a plenum) to be met."""
     from pyhost.fluid_case import box_case
     from pyhost.openfoam import FluidSolver
 
     f, box = scene.fluid, scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     boundaries.update(zlo=("inlet", (0.0, 0.0, f.inlet_velocity)), zhi="outlet")
-    case = box_case(folder, lo=box[0::2], hi=box[1::2], cells=f.cells, boundaries=boundaries, rho=f.density,
+    lo = [box[0], box[2], box[4] - f.plenum]
+    case = box_case(folder, lo=lo, hi=box[1::2], cells=f.cells, boundaries=boundaries, rho=f.density,
                     nu=f.viscosity / f.density, gravity=scene.domain.gravity,
                     dt=scene.time.couple_every * scene.time.dem_step)
     return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min).start()

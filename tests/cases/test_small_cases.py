@@ -116,3 +116,17 @@ def test_results_so_far_survive_a_failure(tmp_path):
     rows = list(csv.DictReader(open(tmp_path / "collisions.csv")))
     assert len(rows) == summary["collisions"] > 0
     assert abs(summary["energy_balance_error"]) < 1e-12
+
+
+def test_hot_cold_bed_smoke(tmp_path):
+    """The default case, fluid on, for 20 ms: heat moves hot to cold, balance exact, fluid written."""
+    rows, summary = run_case("hot-cold-bed", tmp_path, "--test")
+    assert summary["collisions"] > 5000 and summary["capped"] == 0
+    assert abs(summary["energy_balance_error"]) < 1e-12            # walls adiabatic
+    hist = list(csv.DictReader(open(tmp_path / "history.csv")))
+    assert float(hist[-1]["T_group0"]) < 400.0 < 300.0 + 100.0 and float(hist[-1]["T_group1"]) > 300.0
+    reader = pyvista.get_reader(str(tmp_path / "vtk" / "fluid.pvd"))
+    reader.set_active_time_value(reader.time_values[-1])
+    fluid = reader.read()[0]
+    alpha = fluid.point_data["alpha"]
+    assert alpha.min() < 0.7 and alpha.max() == pytest.approx(1.0)   # a bed below, free air above
