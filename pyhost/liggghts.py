@@ -292,7 +292,8 @@ class Liggghts:
                                      shape=(self.nlocal,))
 
     def temperature(self) -> np.ndarray:
-        """Particle temperatures (K) of ``fix heat/gran``: a writable zero-copy view."""
+        """Particle temperatures (K) of ``fix heat/gran``: a writable zero-copy view. Ghost
+        copies (periodic boundaries, other MPI ranks) see a write at the next re-neighbour."""
         return self.property_atom("Temp")
 
     def external_force(self, fix_id: str) -> np.ndarray:
@@ -342,14 +343,15 @@ class Liggghts:
 
     def plane_contacts(self, axis: int, position: float, wall: int = 0) -> Contacts:
         """Contacts with a fixed primitive plane wall ``axis`` = ``position`` (axis 0, 1, 2
-        for x, y, z; m), from geometry: overlap radius - distance (m), area pi (r delta)
-        to first order (m^2); ``j`` is ``wall``, ``vj`` zero."""
+        for x, y, z; m), from geometry: overlap radius - distance (m), area of the cut
+        circle pi (2 r delta - delta^2) (m^2), as LIGGGHTS reports for mesh walls; ``j`` is
+        ``wall``, ``vj`` zero."""
         x, r, v = self.atom("x"), self.atom("radius"), self.atom("v")
         delta = r - np.abs(x[:, axis] - position)
         on = delta > 0
         return Contacts(i=self.atom("id")[on].astype(np.int64), j=np.full(on.sum(), wall),
                         delta=delta[on], vi=v[on].copy(), vj=np.zeros((on.sum(), 3)),
-                        area=np.pi * r[on] * delta[on])
+                        area=np.pi * (2 * r[on] * delta[on] - delta[on] ** 2))
 
     def _contact_array(self, compute_id: str) -> np.ndarray:
         a = self.local_array(compute_id)

@@ -116,6 +116,8 @@ def test_wall_contact_list_shows_the_sphere_for_the_hertz_duration(tmp_path, wal
                 assert np.allclose(c.vi - c.vj, lg.atom("v"))
                 x = lg.atom("x")
                 assert c.delta[0] == pytest.approx(R - (x[0, 2] - z_wall), rel=1e-6, abs=1e-12)
+                lens = np.pi * (2 * R * c.delta[0] - c.delta[0] ** 2)   # the cut circle
+                assert c.area[0] == pytest.approx(lens, rel=1e-6, abs=1e-18)
         expected = hertz_contact_time(V, wall=True) / DT
         print(f"{wall} wall contact: {steps_in_contact} steps, Hertz {expected:.1f}")
         assert abs(steps_in_contact - expected) <= 0.01 * expected + 1
