@@ -51,7 +51,8 @@ def log_tail(log: Path, lines: int = 25) -> str:
 
 
 def run_utility(case: Path, *command: str) -> None:
-    """Run an OpenFOAM utility in ``case`` (log in ``case/log.<utility>``); FluidError on failure."""
+    """Run an OpenFOAM utility in ``case`` (log in ``case/log.<utility>``); FluidError if
+    it fails."""
     log = Path(case) / f"log.{command[0]}"
     with open(log, "w") as out:
         rc = subprocess.run([*command, "-case", str(case)], stdout=out, stderr=subprocess.STDOUT,

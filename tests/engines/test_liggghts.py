@@ -137,7 +137,8 @@ def test_temperatures_written_from_python_drive_the_next_steps(tmp_path):
             if len(c):
                 # fix heat/gran: h = 4 k_i k_j / (k_i + k_j) sqrt(A) = 2 k sqrt(A), with A the
                 # contact area of the list (the lens of two equal spheres: pi (R delta - delta^2/4))
-                assert c.area[0] == pytest.approx(math.pi * (R * c.delta[0] - c.delta[0]**2 / 4), rel=1e-6)
+                lens = math.pi * (R * c.delta[0] - c.delta[0] ** 2 / 4)
+                assert c.area[0] == pytest.approx(lens, rel=1e-6)
                 h_sum += 2 * K * math.sqrt(c.area[0]) * (t1 - t2) * DT
         t1, t2 = lg.temperature()
         assert t1 + t2 == pytest.approx(700.0, abs=1e-9)     # heat is conserved
