@@ -35,9 +35,15 @@ if [ ! -f "$foam_src/.collheat-ready" ]; then
     echo "setup_engines: preparing OpenFOAM headers from Debian's source package in $foam_src"
     src_list=/etc/apt/sources.list.d/collheat-deb-src.sources
     if ! apt-get source --print-uris openfoam >/dev/null 2>&1; then
-        # A deb-src twin of Debian's main entry (the first stanza of debian.sources).
-        awk 'BEGIN{RS=""} NR==1{print}' /etc/apt/sources.list.d/debian.sources \
-            | sed 's/^Types:.*/Types: deb-src/' | $sudo tee "$src_list" >/dev/null
+        # A deb-src twin of Debian's main entry: the first stanza of debian.sources, or
+        # the deb lines of a classic sources.list.
+        if [ -f /etc/apt/sources.list.d/debian.sources ]; then
+            awk 'BEGIN{RS=""} NR==1{print}' /etc/apt/sources.list.d/debian.sources \
+                | sed 's/^Types:.*/Types: deb-src/' | $sudo tee "$src_list" >/dev/null
+        else
+            src_list=/etc/apt/sources.list.d/collheat-deb-src.list
+            sed -n 's/^deb /deb-src /p' /etc/apt/sources.list | $sudo tee "$src_list" >/dev/null
+        fi
         $sudo apt-get update -q
     fi
     dl=$cache/download
