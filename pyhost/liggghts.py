@@ -30,6 +30,7 @@ import numpy as np
 
 LIB = "libliggghts.so.3"
 _ISOLATED = "OMPI_MCA_ess_singleton_isolated"
+_disarm_registered = False
 HELPER = Path(__file__).resolve().parents[1] / ".setup" / "lib" / "libcollheat_liggghts.so"
 
 _c = ctypes
@@ -157,8 +158,10 @@ class Liggghts:
             else:
                 os.environ[_ISOLATED] = saved
         self.helper.collheat_watch_exit(self.ptr, str(self.log).encode())
-        # Python's own exit runs this first: the helper then stays quiet.
-        atexit.register(self.helper.collheat_watch_exit, None, b"")
+        global _disarm_registered
+        if not _disarm_registered:  # Python's own exit runs this first: the helper stays quiet
+            atexit.register(self.helper.collheat_watch_exit, None, b"")
+            _disarm_registered = True
         self._changed = True  # a command since the last run: try the next run first
 
     # -- commands ---------------------------------------------------------------------
