@@ -119,12 +119,13 @@ def test_results_so_far_survive_a_failure(tmp_path):
 
 
 def test_hot_cold_bed_smoke(tmp_path):
-    """The default case, fluid on, for 20 ms: heat moves hot to cold, balance exact, fluid written."""
+    """The default case, fluid on, for 50 ms (the halves meet after ~20 ms): heat moves hot to
+    cold, balance exact, fluid written."""
     rows, summary = run_case("hot-cold-bed", tmp_path, "--test")
     assert summary["collisions"] > 5000 and summary["capped"] == 0
     assert abs(summary["energy_balance_error"]) < 1e-12            # walls adiabatic
     hist = list(csv.DictReader(open(tmp_path / "history.csv")))
-    assert float(hist[-1]["T_group0"]) < 400.0 < 300.0 + 100.0 and float(hist[-1]["T_group1"]) > 300.0
+    assert float(hist[-1]["T_group0"]) < 400.0 and float(hist[-1]["T_group1"]) > 300.0
     reader = pyvista.get_reader(str(tmp_path / "vtk" / "fluid.pvd"))
     reader.set_active_time_value(reader.time_values[-1])
     fluid = reader.read()[0]
