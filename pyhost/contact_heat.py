@@ -7,13 +7,11 @@ plastic deformation starts in the body that yields first.
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
 from plugins.heat import Pair, collide, effective_modulus
 from plugins.heat.fast import collide_fast
-from pyhost.collisions import WALL_BASE
 
 
 def pair_properties(mat1, mat2) -> dict:

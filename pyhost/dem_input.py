@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from plugins.heat.compression import K_HERTZ
 from pyhost.scene import Scene, SceneError
 
 PLANES = {"xlo": ("xplane", 0), "xhi": ("xplane", 1), "ylo": ("yplane", 2), "yhi": ("yplane", 3),
@@ -146,5 +147,5 @@ def dem_collision_time(scene: Scene, v: float) -> float:
         m = scene.materials[grp.material]
         E = m.dem.youngs_modulus / (2.0 * (1.0 - m.dem.poisson_ratio**2))
         R, mass = grp.radius / 2.0, 4.0 / 3.0 * math.pi * grp.radius**3 * m.density / 2.0
-        times.append(2.8683 * (mass**2 / (E**2 * R * v)) ** 0.2)
+        times.append(2.0 * K_HERTZ * (15.0 / 16.0) ** 0.4 * (mass**2 / (E**2 * R * v)) ** 0.2)
     return min(times)

@@ -14,7 +14,6 @@ How a contact is classified (collision, then enduring) is told in ``pyhost.colli
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np

@@ -134,7 +134,7 @@ def _flat(err):
 
 
 def print_table(rows):
-    print(f"\n| path | setting | cost per collision [s] (min-max) | " +
+    print("\n| path | setting | cost per collision [s] (min-max) | " +
           " | ".join(f"{q} max / median" for q in QUANT) + " |")
     print("|---|---|---|" + "---|" * len(QUANT))
     for r in rows:

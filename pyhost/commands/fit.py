@@ -37,7 +37,7 @@ def run(args) -> int:
     if args.n < 10:
         raise ValueError(f"--n must be at least 10, got {args.n}")
     FR = load_tool("fit_relations")
-    lo, hi = F.VALIDITY["v_hat"][0], F.VALIDITY["v_hat"][1]
+    hi = F.VALIDITY["v_hat"][1]
     print(f"design: {args.n} random pairs x models A, B, C by the exact path, "
           f"v0/v_y log-uniform in [1, {hi:g}], b1 in {F.VALIDITY['b1']}, b2/b1 in {F.VALIDITY['beta']}")
     data = FR.design(args.n, args.seed)

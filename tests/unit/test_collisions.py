@@ -1,5 +1,4 @@
 """The host's collision logic without engines: impact speed, contact tracking, heat exchange."""
-import math
 
 import numpy as np
 import pytest

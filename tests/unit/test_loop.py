@@ -5,7 +5,6 @@ the host's own logic (detection, impact speed, heat, restitution, conservation) 
 on its own.
 """
 import csv
-import json
 
 import numpy as np
 import pytest
@@ -25,7 +24,6 @@ class NumpyDem:
         self.x, self.v = particles.position.copy(), particles.velocity.copy()
         m = next(iter(scene.materials.values())).dem
         self.law = DemHertz(m.youngs_modulus / (2 * (1 - m.poisson_ratio**2)), m.restitution)
-        self.wall_law = DemHertz(m.youngs_modulus / (2 * (1 - m.poisson_ratio**2)), m.restitution)
         self.calls = 0
 
     def forces(self):
@@ -36,8 +34,7 @@ class NumpyDem:
         jj = np.where(wall, 0, c.j)
         R = np.where(wall, self.p.radius[c.i], self.p.radius[c.i] * self.p.radius[jj] / (self.p.radius[c.i] + self.p.radius[jj]))
         m = np.where(wall, self.p.mass[c.i], self.p.mass[c.i] * self.p.mass[jj] / (self.p.mass[c.i] + self.p.mass[jj]))
-        law = self.law
-        f = np.maximum(law.force(c.delta, c.approach, R, m), 0.0)
+        f = np.maximum(self.law.force(c.delta, c.approach, R, m), 0.0)
         np.add.at(F, c.i, f[:, None] * c.normal)
         np.add.at(F, jj[~wall], -f[~wall, None] * c.normal[~wall])
         return F / self.p.mass[:, None] + np.asarray(self.scene.domain.gravity)

@@ -6,7 +6,6 @@ the integrated a(t) by finding, for each contact radius, when it was reached and
 """
 import math
 
-import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq

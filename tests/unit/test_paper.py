@@ -5,7 +5,7 @@ import pytest
 from scipy.optimize import brentq
 from scipy.special import beta
 
-from plugins.heat import Pair, collide
+from plugins.heat import collide
 
 
 def test_yield_onset_speed_is_printed_value(paper_pair):
@@ -25,13 +25,15 @@ def test_fully_plastic_onset_reached_at_delta_p(paper_pair):
     assert 1.05 < v_p < 1.15
 
 
-def test_onset_speeds_exactly(paper_pair):
-    # a speed of exactly v_y or v_p (as computed) lands on the regime boundary
+@pytest.mark.parametrize("model", ["A", "C"])
+def test_onset_speeds_exactly(paper_pair, model):
+    # a speed of exactly v_y or v_p (as computed) lands on the regime boundary, eqs. (6), (10)
     v_y, v_p = paper_pair.onset_speeds()
-    for model in ("A", "B", "C"):
-        assert collide(v_y, paper_pair, model).delta_max == pytest.approx(paper_pair.delta_y, rel=1e-12) \
-            or model == "B"
-        assert collide(v_p, paper_pair, model).e > 0
+    X_p = math.exp(3 * (paper_pair.b2 - paper_pair.b1))
+    assert collide(v_y, paper_pair, model).delta_max == pytest.approx(paper_pair.delta_y, rel=1e-12)
+    at_p = collide(v_p, paper_pair, model)
+    assert at_p.delta_max == pytest.approx(paper_pair.delta_y * (X_p + 1) / 2, rel=1e-12)
+    assert at_p.regime == "elastic-plastic"
 
 
 def test_recovery_ratios_tend_to_b1_over_b2(paper_pair):

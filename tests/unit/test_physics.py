@@ -1,5 +1,4 @@
 """Physical facts every model must satisfy, checked on the exact path."""
-import dataclasses
 import math
 
 import numpy as np
