@@ -37,22 +37,107 @@ def plot_history(out: Path) -> Path:
     return path
 
 
+WINDOW = (900, 700)          # particles.png [px], 3-D view of a scene without fluid
+WINDOW_FLUID = (900, 800)    # particles.png [px], front view of a fluid run
+
+
+def _levels(x, tol: float) -> tuple[int, float, float]:
+    """Number of distinct values (apart by more than tol), lowest value and spacing of equally
+    spaced coordinates x [m] (spacing 0 for one value)."""
+    x = np.sort(np.asarray(x, float))
+    n = 1 + int(np.sum(np.diff(x) > tol))
+    return n, (x[0] + x[-1]) / 2 if n == 1 else x[0], (x[-1] - x[0]) / (n - 1) if n > 1 else 0.0
+
+
+def fluid_grid(centres, alpha, box=None):
+    """The fluid cells as a pyvista ImageData with cell data ``alpha`` (fluid volume fraction
+    [-]), rebuilt from the cell centres [m] of a uniform box mesh, in any order. The spacing of
+    each axis comes from its distinct centre coordinates; an axis with a single cell takes its
+    width from ``box`` (xlo xhi ylo yhi zlo zhi [m], the fluid box) or else the mean spacing of
+    the other axes."""
+    import pyvista
+
+    c = np.asarray(centres, float)
+    tol = 1e-6 * np.ptp(c, axis=0).max()
+    n, lo, h = map(np.array, zip(*(_levels(c[:, k], tol) for k in range(3))))
+    for k in np.flatnonzero(n == 1):
+        h[k] = box[2 * k + 1] - box[2 * k] if box is not None else (h[h > 0].mean() if np.any(h > 0) else 1.0)
+    if np.prod(n) != len(c):
+        raise ValueError(f"{len(c)} cell centres do not fill a uniform {n[0]} x {n[1]} x {n[2]} grid")
+    ijk = np.rint((c - lo) / np.where(h > 0, h, 1.0)).astype(int) * (n > 1)
+    values = np.full(len(c), np.nan)
+    values[ijk[:, 0] + n[0] * (ijk[:, 1] + n[1] * ijk[:, 2])] = alpha   # VTK order: x fastest
+    grid = pyvista.ImageData(dimensions=n + 1, spacing=h, origin=lo - h / 2)
+    grid.cell_data["alpha"] = values
+    return grid
+
+
+def _frame(pvd: Path, t: float | None = None):
+    """The frame of a .pvd series nearest time t [s] (the last frame without t), and its time."""
+    import pyvista
+
+    reader = pyvista.get_reader(str(pvd))
+    times = np.asarray(reader.time_values)
+    time = times[-1] if t is None else times[np.argmin(np.abs(times - t))]
+    reader.set_active_time_value(time)
+    return reader.read()[0], float(time)
+
+
 def render_particles(out: Path) -> Path:
-    """The last VTK frame, spheres coloured by temperature, rendered off screen -> out/particles.png."""
+    """The last VTK frame rendered off screen -> out/particles.png: the particles as spheres
+    coloured by temperature [K]. For a fluid run (out/vtk/fluid.pvd) they are drawn over the
+    fluid volume fraction [-] of the same frame: the mid-y slice of the fluid cells (domain box
+    and plenum below it), placed at the back face and viewed from the front (-y), framed on the
+    bed (plenum to a little above the highest particle), so a pseudo-2-D bed reads like the
+    usual 2-D bed picture."""
     import pyvista
 
     pyvista.OFF_SCREEN = True
-    reader = pyvista.get_reader(str(out / "vtk" / "particles.pvd"))
-    reader.set_active_time_value(reader.time_values[-1])
-    cloud = reader.read()[0]
+    cloud, t = _frame(out / "vtk" / "particles.pvd")
     spheres = cloud.glyph(geom=pyvista.Sphere(theta_resolution=12, phi_resolution=12), scale="radius",
                           factor=2.0, orient=False)
-    plotter = pyvista.Plotter(off_screen=True, window_size=(900, 700))
+    has_fluid = (out / "vtk" / "fluid.pvd").exists()
+    plotter = pyvista.Plotter(off_screen=True, window_size=WINDOW_FLUID if has_fluid else WINDOW)
+    bar = dict(vertical=True, width=0.05, height=0.5, position_y=0.25, title_font_size=14, label_font_size=14)
     plotter.add_mesh(spheres, scalars="temperature", cmap="coolwarm",
-                     scalar_bar_args={"title": "temperature [K]"})
-    plotter.add_text(f"t = {reader.time_values[-1] * 1e3:.3g} ms", font_size=10)
-    plotter.view_isometric()
+                     scalar_bar_args=dict(bar, title="temperature [K]\n", position_x=0.88, fmt="%.0f")
+                     if has_fluid else {"title": "temperature [K]"})
+    if has_fluid:
+        cells, _ = _frame(out / "vtk" / "fluid.pvd", t)
+        grid = fluid_grid(cells.points, cells.point_data["alpha"], _fluid_box(out))
+        x0, x1, y0, y1, z0, z1 = grid.bounds
+        back = grid.slice(normal="y", origin=grid.center).translate((0, y1 + 0.02 * (y1 - y0) - grid.center[1], 0))
+        lo = min(np.floor(10 * np.nanmin(grid.cell_data["alpha"])) / 10, 0.9)
+        plotter.add_mesh(back, scalars="alpha", cmap="gray", clim=(lo, 1.0), lighting=False,
+                         scalar_bar_args=dict(bar, title="fluid fraction [-]\n", position_x=0.04, fmt="%.1f",
+                                              n_labels=round(10 * (1 - lo)) + 1))
+        plotter.add_mesh(back.outline(), color="black")
+        top = spheres.bounds[5]
+        top = min(z1, top + 0.3 * (top - z0))                # the bed and a little above it
+        centre = np.array([(x0 + x1) / 2, y1, (z0 + top) / 2])
+        plotter.camera.focal_point = centre
+        plotter.camera.position = centre - [0, 10 * (x1 - x0 + top - z0), 0]
+        plotter.camera.up = (0, 0, 1)
+        plotter.enable_parallel_projection()
+        width, height = WINDOW_FLUID
+        plotter.camera.parallel_scale = 0.52 * max(top - z0, (x1 - x0) * height / (0.7 * width))
+    else:
+        plotter.view_isometric()
+    plotter.add_text(f"t = {t * 1e3:.3g} ms", position="upper_left", font_size=12)
     path = out / "particles.png"
     plotter.screenshot(str(path))
     plotter.close()
     return path
+
+
+def _fluid_box(out: Path):
+    """The fluid box (domain box and the plenum below it), xlo xhi ylo yhi zlo zhi [m], from the
+    run's scene.json; None if it has none."""
+    import json
+
+    if not (out / "scene.json").exists():
+        return None
+    scene = json.loads((out / "scene.json").read_text())
+    box = list(scene["domain"]["box"])
+    box[4] -= (scene.get("fluid") or {}).get("plenum", 0.0)
+    return box

@@ -1,0 +1,74 @@
+"""particles.png of a fluid run: the particles over the fluid fraction, from a synthetic output
+folder (no engines). The picture itself is drawn in its own process, as ``pyhost run`` does."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from pyhost.output import VtkSeries
+from pyhost.pictures import WINDOW, WINDOW_FLUID, fluid_grid
+
+BOX = [0.0, 0.04, 0.0, 0.004, 0.0, 0.05]    # domain [m]; plenum 0.01 m below: fluid z -0.01..0.05
+PLENUM = 0.01
+
+
+def cells():
+    """Centres of a 4 x 1 x 6 mesh of 10 mm (4 mm in y) cells, shuffled, with float noise as
+    OpenFOAM writes them, and alpha 0.4 in the lower half (z < 0.02 m), 1.0 above."""
+    x, y, z = np.meshgrid([0.005, 0.015, 0.025, 0.035], [0.002], np.arange(-0.005, 0.05, 0.01), indexing="ij")
+    c = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+    c = np.random.default_rng(1).permutation(c) + 1e-16 * np.random.default_rng(2).standard_normal(c.shape)
+    return c, np.where(c[:, 2] < 0.02, 0.4, 1.0)
+
+
+def write_run(out, fluid=True):
+    centres, alpha = cells()
+    history = out / "history.csv"
+    history.write_text("time,T_group0,collisions\n0.0,300.0,0\n0.01,300.5,7\n")
+    (out / "scene.json").write_text(json.dumps({"domain": {"box": BOX},
+                                                "fluid": {"plenum": PLENUM, "cells": [4, 1, 6]}}))
+    x = np.array([[0.01, 0.002, 0.005], [0.02, 0.002, 0.005], [0.03, 0.002, 0.025]])
+    particles = VtkSeries(out / "vtk", "particles")
+    if fluid:
+        frames = VtkSeries(out / "vtk", "fluid")
+    for t in (0.0, 0.01):
+        particles.write(t, x, id=np.arange(1, 4), radius=np.full(3, 0.001), velocity=np.zeros((3, 3)),
+                        temperature=np.array([300.0, 350.0, 400.0]))
+        if fluid:
+            frames.write(t, centres, alpha=alpha, velocity=np.zeros((24, 3)), pressure=np.zeros(24))
+
+
+def test_fluid_grid_rebuilds_the_cells():
+    centres, alpha = cells()
+    grid = fluid_grid(centres, alpha, box=BOX[:4] + [BOX[4] - PLENUM, BOX[5]])
+    assert grid.n_cells == 24
+    assert grid.dimensions == (5, 2, 7)
+    assert np.allclose(grid.spacing, (0.01, 0.004, 0.01))
+    assert np.allclose(grid.bounds, (0.0, 0.04, 0.0, 0.004, -0.01, 0.05))
+    a = grid.cell_data["alpha"]
+    for point, value in [((0.005, 0.002, -0.005), 0.4), ((0.035, 0.002, 0.015), 0.4),
+                         ((0.005, 0.002, 0.025), 1.0), ((0.035, 0.001, 0.045), 1.0)]:
+        assert a[grid.find_containing_cell(point)] == value
+    assert np.sum(a == 0.4) == 12 and np.sum(a == 1.0) == 12
+
+
+def test_fluid_grid_without_box_and_not_uniform():
+    centres, alpha = cells()
+    assert np.allclose(fluid_grid(centres, alpha).spacing, (0.01, 0.01, 0.01))   # 1 cell in y: the others' spacing
+    with pytest.raises(ValueError, match="uniform"):
+        fluid_grid(centres[1:], alpha[1:])
+
+
+@pytest.mark.parametrize("fluid", [True, False])
+def test_particles_png(tmp_path, fluid):
+    write_run(tmp_path, fluid)
+    r = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    image = np.asarray(Image.open(tmp_path / "particles.png").convert("RGB")).astype(int)
+    assert image.shape[1::-1] == (WINDOW_FLUID if fluid else WINDOW)
+    # the lower half of the fluid (alpha 0.4, the bottom of the grey map) is drawn black behind the particles
+    black = np.sum(np.all(image < 30, axis=2))
+    assert black > 0.1 * image.shape[0] * image.shape[1] if fluid else black < 0.02 * image.shape[0] * image.shape[1]
