@@ -25,7 +25,8 @@ from foamlib import FoamFile
 
 from pyhost import drag as drag_laws
 
-SOLVER = Path(__file__).resolve().parents[1] / ".setup" / "bin" / "collheatFoam"
+# The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
+SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[1] / ".setup" / "bin" / "collheatFoam"))
 LOCATE, ADVANCE, FIELDS, WRITE, STOP = 1, 2, 3, 4, 5
 
 
