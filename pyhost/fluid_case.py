@@ -5,6 +5,8 @@ the six faces (xlo, xhi, ylo, yhi, zlo, zhi) gets one boundary kind:
 
 - ``"wall"``: no-slip wall; ``"slip"``: frictionless wall (both: fixedFluxPressure);
 - ``("inlet", (ux, uy, uz))``: fixed velocity (m/s), fixedFluxPressure;
+- ``("inlet_table", [(t, (ux, uy, uz)), ...])``: velocity (m/s) piecewise linear in time t
+  (s), held after the last row (OpenFOAM's uniformFixedValue table), fixedFluxPressure;
 - ``"outlet"``: fixed pressure 0, velocity zeroGradient (inletOutlet).
 """
 from __future__ import annotations
@@ -31,8 +33,11 @@ def _dict(path: Path, class_: str = "dictionary") -> FoamFile:
 
 def _bc(kind, field: str) -> dict:
     name, value = (kind if isinstance(kind, tuple) else (kind, None))
-    if name not in ("wall", "slip", "inlet", "outlet"):
-        raise ValueError(f"unknown boundary kind '{name}'; choices: wall, slip, inlet, outlet")
+    if name not in ("wall", "slip", "inlet", "inlet_table", "outlet"):
+        raise ValueError(f"unknown boundary kind '{name}'; choices: wall, slip, inlet, inlet_table, outlet")
+    if field == "U" and name == "inlet_table":
+        rows = [[float(t), [float(c) for c in u]] for t, u in value]
+        return {"type": "uniformFixedValue", "uniformValue": ("table", rows), "value": np.array(rows[0][1])}
     if field == "U":
         return {"wall": {"type": "noSlip"}, "slip": {"type": "slip"},
                 "inlet": {"type": "fixedValue", "value": np.asarray(value, float)},

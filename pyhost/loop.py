@@ -25,6 +25,7 @@ from pyhost.dem_input import Particles, material_index
 from pyhost.output import CsvLog, Progress, VtkSeries
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
+FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
 
 
 class Coupling:
@@ -53,7 +54,8 @@ class Coupling:
         self.groups = [np.flatnonzero(particles.group == k) for k in range(len(scene.particles))]
         self.history = CsvLog(self.out / "history.csv", ("time", "T_mean", "T_min", "T_max")
                               + tuple(f"T_group{k}" for k in range(len(self.groups)))
-                              + ("sum_mcT", "heat_from_walls", "collisions", "capped", "clipped"))
+                              + ("sum_mcT", "heat_from_walls", "collisions", "capped", "clipped")
+                              + (FLUID_COLUMNS if fluid is not None else ()))
         self.frames = VtkSeries(self.out / "vtk", "particles") if scene.output.vtk else None
         self.progress = Progress(scene.time.end, progress_every)
 
@@ -89,6 +91,9 @@ class Coupling:
         """The fluid's force on each particle from the current fluid, then the fluid advanced
         over the next coupling interval with these particles' fraction and drag."""
         x, v = self.dem.state()
+        d = self.scene.domain
+        lo, hi = np.array(d.box[0::2]), np.array(d.box[1::2])
+        x = np.where(d.periodic, lo + np.mod(x - lo, hi - lo), x)   # the DEM wraps only at re-neighbouring
         self.dem.set_force(self.fluid.couple(x, v, 2.0 * self.p.radius, duration))
 
     def sample_contacts(self, dt_sample: float) -> None:
@@ -193,14 +198,27 @@ class Coupling:
         self.totals["heat_from_walls"] += from_walls
         self.totals["capped"] += capped
 
+    def bed_state(self, x) -> tuple:
+        """The fluid columns of history.csv: the superficial inlet velocity [m/s]; the pressure
+        drop the particles cause [Pa], mean p of the lowest cell layer less that of the highest,
+        less the fluid's own hydrostatic head between them; the bed height [m], twice the mean
+        particle centre height above the box floor (exact for a uniform bed)."""
+        p, _ = self.fluid.fields()
+        z = self.fluid.cell_centres[:, 2]
+        low, high = z == z.min(), z == z.max()
+        head = self.scene.fluid.density * self.scene.domain.gravity[2] * (z.max() - z.min())
+        dp = float(p[low].mean() - p[high].mean() + head)
+        return (float(self.scene.fluid.inlet_at(self.t)), dp, 2.0 * float(np.mean(x[:, 2] - self.scene.domain.box[4])))
+
     def write_frame(self) -> None:
         tot = self.totals
+        x, v = self.dem.state() if self.frames is not None or self.fluid is not None else (None, None)
         group_means = tuple(float(np.sum(self.C[g] * self.T[g]) / np.sum(self.C[g])) for g in self.groups)
         self.history.write([(self.t, float(self.T.mean()), float(self.T.min()), float(self.T.max()))
                             + group_means + (float(np.sum(self.C * self.T)), tot["heat_from_walls"],
-                                             tot["collisions"], tot["capped"], tot["clipped"])])
+                                             tot["collisions"], tot["capped"], tot["clipped"])
+                            + (self.bed_state(x) if self.fluid is not None else ())])
         if self.frames is not None:
-            x, v = self.dem.state()
             self.frames.write(self.t, x, id=np.arange(1, len(x) + 1), radius=self.p.radius, velocity=v,
                               temperature=self.T)
         if self.fluid_frames is not None:

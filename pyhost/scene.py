@@ -47,6 +47,8 @@ import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from plugins.heat import MODELS
 
 
@@ -138,12 +140,21 @@ class Fluid:
     density: float = spec(">0", 1.2, "[kg/m^3]")
     viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
     inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the inlet (fluid z lo) [m/s]")
+    inlet_table: list = spec(default=[], doc="[[time s, superficial velocity m/s], ...] instead of "
+                                             "inlet_velocity: piecewise linear, held after the last")
     plenum: float = spec(">=0", 0.0, "particle-free fluid layer below the box [m]: the box's z lo "
                                       "wall is then a distributor, and the inlet sees no particles")
     drag: str = spec("in:difelice,gidaspow,ergun,wenyu", "gidaspow", "drag law (pyhost.drag)")
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
     sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")
     alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]")
+
+    def inlet_at(self, t):
+        """Superficial inlet velocity [m/s] at time t [s] (scalar or array)."""
+        if not self.inlet_table:
+            return self.inlet_velocity + 0.0 * np.asarray(t, float)
+        times, speeds = np.array(self.inlet_table, float).T
+        return np.interp(t, times, speeds)
 
 
 @dataclass(frozen=True)
@@ -226,6 +237,21 @@ def _box(values, key, file, n=6):
         raise SceneError(f"{file}: {key}: each min must be below its max, got {values!r}")
 
 
+def _inlet_table(fluid, file):
+    key = f"{file}: fluid.inlet_table"
+    if fluid.inlet_velocity:
+        raise SceneError(f"{key}: give either inlet_table or inlet_velocity, not both")
+    for row in fluid.inlet_table:
+        if not isinstance(row, list):
+            raise SceneError(f"{key}: each row must be [time, velocity], got {row!r}")
+        _box(row, "fluid.inlet_table", file, 2)
+        if row[0] < 0 or row[1] < 0:
+            raise SceneError(f"{key}: times and velocities must be >= 0, got {row!r}")
+    times = [row[0] for row in fluid.inlet_table]
+    if any(b <= a for a, b in zip(times, times[1:])):
+        raise SceneError(f"{key}: times must increase, got {times!r}")
+
+
 SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output")
 
 
@@ -282,5 +308,7 @@ def load_scene(path) -> Scene:
         raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
     if fluid is not None and (len(fluid.cells) != 3 or not all(isinstance(n, int) and n > 0 for n in fluid.cells)):
         raise SceneError(f"{file}: fluid.cells: must be 3 positive integers, got {fluid.cells!r}")
+    if fluid is not None and fluid.inlet_table:
+        _inlet_table(fluid, file)
     output = _build(Output, data.get("output", {}), "output", file)
     return Scene(path, effects, materials, particles, domain, time, walls, fluid, output)

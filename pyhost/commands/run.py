@@ -33,7 +33,9 @@ def start_fluid(scene, folder: Path):
 
     f, box = scene.fluid, scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
-    boundaries.update(zlo=("inlet", (0.0, 0.0, f.inlet_velocity)), zhi="outlet")
+    inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
+             else ("inlet", (0.0, 0.0, f.inlet_velocity)))
+    boundaries.update(zlo=inlet, zhi="outlet")
     lo = [box[0], box[2], box[4] - f.plenum]
     case = box_case(folder, lo=lo, hi=box[1::2], cells=f.cells, boundaries=boundaries, rho=f.density,
                     nu=f.viscosity / f.density, gravity=scene.domain.gravity,

@@ -87,3 +87,33 @@ def test_missing_file_and_broken_toml(tmp_path):
         load_scene(tmp_path / "nope.toml")
     with pytest.raises(SceneError, match="not valid TOML"):
         load_scene(write(tmp_path, "[effects\n"))
+
+
+FLUID = "\n[fluid]\ninlet_table = [[0.0, 0.0], [0.1, 0.0], [0.11, 0.5]]\n"
+
+
+def test_inlet_table_is_piecewise_linear_and_held(tmp_path):
+    s = load_scene(write(tmp_path, VALID + FLUID))
+    assert s.fluid.inlet_at(0.05) == 0.0
+    assert s.fluid.inlet_at(0.105) == pytest.approx(0.25, rel=1e-12)
+    assert s.fluid.inlet_at(1.0) == 0.5
+    plain = load_scene(write(tmp_path, VALID + "\n[fluid]\ninlet_velocity = 1.5\n"))
+    assert plain.fluid.inlet_at(0.3) == 1.5
+
+
+@pytest.mark.parametrize("table,message", [
+    ("[[0.0, 0.0], [0.0, 0.5]]", "times must increase"),
+    ("[[0.0, -0.1]]", "must be >= 0"),
+    ("[[0.0, 0.0, 1.0]]", "must be 2 numbers"),
+    ("[0.0, 0.1]", "each row must be [time, velocity]"),
+])
+def test_bad_inlet_table_names_the_key(tmp_path, table, message):
+    path = write(tmp_path, VALID + f"\n[fluid]\ninlet_table = {table}\n")
+    with pytest.raises(SceneError) as err:
+        load_scene(path)
+    assert "fluid.inlet_table" in str(err.value) and message in str(err.value)
+
+
+def test_inlet_table_and_velocity_exclude_each_other(tmp_path):
+    with pytest.raises(SceneError, match="either inlet_table or inlet_velocity"):
+        load_scene(write(tmp_path, VALID + FLUID.replace("[fluid]", "[fluid]\ninlet_velocity = 1.0")))
