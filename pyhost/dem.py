@@ -35,6 +35,9 @@ class SceneDem:
         self.lmp = Liggghts(workdir)
         self.lmp.file(script)
         self.lmp.run(0)
+        if fluid_force:     # run 0 added the fix's array while it was uninitialised memory, and the
+            self.lmp.external_force(FLUID_FIX)[:] = 0.0   # first step would integrate that force:
+            self.lmp.command("run 0")                     # zero it and set up again
         self._views()
 
     def _views(self) -> None:
