@@ -301,7 +301,9 @@ class Liggghts:
 
     def external_force(self, fix_id: str) -> np.ndarray:
         """Writable zero-copy (n, 3) view of the force (N) that ``fix <fix_id> all external
-        pf/array 1`` adds to each local atom every step."""
+        pf/array 1`` adds to each local atom every step. It holds uninitialised memory until
+        written, and the set-up of a run already adds it: write it (or zero it) and run a
+        set-up again (``command("run 0")``) before the first step, as ``SceneDem`` does."""
         raw = self.helper.collheat_fix_external_force(self.ptr, fix_id.encode())
         if not raw:
             raise LiggghtsError(f"no 'fix {fix_id} ... external pf/array' (or no run yet)")
