@@ -123,7 +123,8 @@ def clear_fluid_force(dem) -> None:
     """Zero the fluid force before the first step. SceneDem's set-up run (``run 0``) adds the
     fluid fix's per-atom array while it is still uninitialised memory, and the first step
     integrates that force: after earlier engines in the same process it holds leftovers,
-    up to forces that throw particles out of the domain. Set it to zero, then set up again."""
+    up to forces that throw particles out of the domain. Set it to zero, then set up again.
+    (SceneDem now does the same itself; this costs one more set-up.)"""
     dem.set_force(np.zeros((dem.n, 3)))
     dem.lmp.command("run 0")
     dem.run(0)
