@@ -28,6 +28,15 @@ COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model"
 FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
 
 
+def layer_pressure_drop(fluid) -> float:
+    """Mean pressure [Pa] of the fluid's lowest cell layer less that of its highest. Layers
+    are matched with a tolerance: cell centres of one layer differ in their last digits."""
+    p, _ = fluid.fields()
+    z = fluid.cell_centres[:, 2]
+    tol = 1e-6 * (z.max() - z.min())
+    return float(p[z < z.min() + tol].mean() - p[z > z.max() - tol].mean())
+
+
 class Coupling:
     """One run of a scene with a DEM engine; ``run()`` returns the summary it also writes."""
 
@@ -203,12 +212,10 @@ class Coupling:
         drop the particles cause [Pa], mean p of the lowest cell layer less that of the highest,
         less the fluid's own hydrostatic head between them; the bed height [m], twice the mean
         particle centre height above the box floor (exact for a uniform bed)."""
-        p, _ = self.fluid.fields()
         z = self.fluid.cell_centres[:, 2]
-        low, high = z == z.min(), z == z.max()
         head = self.scene.fluid.density * self.scene.domain.gravity[2] * (z.max() - z.min())
-        dp = float(p[low].mean() - p[high].mean() + head)
-        return (float(self.scene.fluid.inlet_at(self.t)), dp, 2.0 * float(np.mean(x[:, 2] - self.scene.domain.box[4])))
+        return (float(self.scene.fluid.inlet_at(self.t)), layer_pressure_drop(self.fluid) + head,
+                2.0 * float(np.mean(x[:, 2] - self.scene.domain.box[4])))
 
     def write_frame(self) -> None:
         tot = self.totals

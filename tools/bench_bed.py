@@ -64,7 +64,7 @@ from pyhost.collisions import contact_keys
 from pyhost.commands.run import start_fluid
 from pyhost.dem import SceneDem
 from pyhost.dem_input import place_particles
-from pyhost.loop import Coupling
+from pyhost.loop import Coupling, layer_pressure_drop
 from pyhost.scene import load_scene
 
 CASE = Path(__file__).resolve().parents[1] / "cases" / "hot-cold-bed" / "case.toml"
@@ -77,13 +77,6 @@ def variant(scene, end, couple_every=None, **effects):
         scene, effects=dataclasses.replace(scene.effects, **effects),
         time=dataclasses.replace(scene.time, end=end, couple_every=couple_every or scene.time.couple_every),
         output=dataclasses.replace(scene.output, vtk=False, pictures=False, every=end))
-
-
-def pressure_drop(fluid) -> float:
-    """Mean pressure of the lowest cell layer minus that of the highest [Pa]."""
-    p, _ = fluid.fields()
-    z = fluid.cell_centres[:, 2]
-    return float(p[np.isclose(z, z.min())].mean() - p[np.isclose(z, z.max())].mean())
 
 
 class Probe:
@@ -115,19 +108,8 @@ class Probe:
             self.snaps.append({"t": len(self.F) * self.dt, "v": np.array(v, copy=True),
                                "N": totals["collisions"], "Q": totals["heat_moved"]})
         self.F.append(forces[:, 2].sum())
-        self.dp.append(pressure_drop(self.fluid))
+        self.dp.append(layer_pressure_drop(self.fluid))
         self.overhead += time.perf_counter() - t0
-
-
-def clear_fluid_force(dem) -> None:
-    """Zero the fluid force before the first step. SceneDem's set-up run (``run 0``) adds the
-    fluid fix's per-atom array while it is still uninitialised memory, and the first step
-    integrates that force: after earlier engines in the same process it holds leftovers,
-    up to forces that throw particles out of the domain. Set it to zero, then set up again.
-    (SceneDem now does the same itself; this costs one more set-up.)"""
-    dem.set_force(np.zeros((dem.n, 3)))
-    dem.lmp.command("run 0")
-    dem.run(0)
 
 
 def open_contacts(coupling) -> None:
@@ -156,8 +138,6 @@ def run(scene, out: Path, particles=None, fluid_on: bool = True, record: bool = 
     try:
         dem = SceneDem(scene, particles, out / "dem", fluid_force=fluid_on)
         try:
-            if fluid_on:
-                clear_fluid_force(dem)
             if fluid_on and record:
                 k = scene.time.couple_every
                 probe = Probe(fluid, STRIDE // k, k * scene.time.dem_step)
@@ -246,7 +226,7 @@ def fluid_step_table(base, weight: float, out: Path, end: float = 0.004) -> None
             for _ in range(round(end / (k * dt))):
                 fluid.couple(p.position, p.velocity, 2.0 * p.radius, k * dt, substeps)
             F = fluid.particle_forces(p.position, p.velocity, 2.0 * p.radius)[:, 2].sum()
-            print(f"{k * dt / substeps:14.1e} | {100 * F / weight:6.1f} | {pressure_drop(fluid):7.1f}", flush=True)
+            print(f"{k * dt / substeps:14.1e} | {100 * F / weight:6.1f} | {layer_pressure_drop(fluid):7.1f}", flush=True)
         finally:
             fluid.stop()
 
