@@ -92,7 +92,7 @@ class Coupling:
         self.seen = np.zeros(0, bool)
         self.warned = set()
         self.heat = self.effects["collision_heat"]
-        self.laws = self.dem_laws()
+        self.laws = {}
         if self.heat and dem.info.heat_gran:
             self.check_capacities()
         atoms = dem.atoms(self.heat)
@@ -188,18 +188,15 @@ class Coupling:
         if self.heat and self.dem.info.heat_gran and len(c):
             self.undo_heat_gran(atoms, c, keys)
 
-    def dem_laws(self) -> dict:
-        """The DEM's Hertz law for each pair of atom types, from the script's own values
-        (LIGGGHTS' effective modulus and per-pair restitution)."""
-        n = len(self.type_material) - 1
-        if not self.effects["contact_extraction"] or n < 1:
-            return {}
-        E = self.dem.type_values("youngsModulus", n)
-        nu = self.dem.type_values("poissonsRatio", n)
-        e = self.dem.type_pair_values("coefficientRestitution", n)
-        return {(a, b): DemHertz(1.0 / ((1 - nu[a - 1] ** 2) / E[a - 1] + (1 - nu[b - 1] ** 2) / E[b - 1]),
-                                 float(e[a - 1, b - 1]))
-                for a in range(1, n + 1) for b in range(1, n + 1)}
+    def dem_law(self, a: int, b: int) -> DemHertz:
+        """The DEM's Hertz law between atom types a and b, from the script's own values
+        (LIGGGHTS' effective modulus and per-pair restitution); read once per pair."""
+        if (a, b) not in self.laws:
+            E = [self.dem.lmp.fix_global(self.dem.info.globals["youngsModulus"], t - 1) for t in (a, b)]
+            nu = [self.dem.lmp.fix_global(self.dem.info.globals["poissonsRatio"], t - 1) for t in (a, b)]
+            e = self.dem.lmp.fix_global(self.dem.info.globals["coefficientRestitution"], a - 1, b - 1)
+            self.laws[a, b] = DemHertz(1.0 / ((1 - nu[0] ** 2) / E[0] + (1 - nu[1] ** 2) / E[1]), e)
+        return self.laws[a, b]
 
     def check_capacities(self) -> None:
         """A script's fix heat/gran integrates Temp with its own thermalCapacity: it must be the
@@ -241,7 +238,7 @@ class Coupling:
         if self.dem.info.pair_model == "hertz":
             for (a, b) in set(zip(ti.tolist(), tj.tolist())):
                 s = (ti == a) & (tj == b)
-                v0[s] = self.laws[a, b].impact_speed(delta[s], approach[s], R_eff[s], m_eff[s],
+                v0[s] = self.dem_law(a, b).impact_speed(delta[s], approach[s], R_eff[s], m_eff[s],
                                                      window=self.every["sample"] * self.dem.dt)
         elif "model" not in self.warned:
             self.warned.add("model")
@@ -364,8 +361,9 @@ class Coupling:
             self.track_particles(atoms)
             CT = float(np.sum(self.C * atoms.T))
             t = self.totals
-            summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=(
-                CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]) / self.CT0)
+            summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=(    # relative to all
+                CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"])     # that came in
+                / max(self.CT0 + t["energy_in"], 1e-300))
         (self.out / "summary.json").write_text(json.dumps(summary, indent=1))
         self.collisions.close()
         self.history.close()
