@@ -343,10 +343,11 @@ class Coupling:
         less the fluid's own hydrostatic head between them; the bed height [m], twice the mean
         particle centre height above the box floor (exact for a uniform bed)."""
         z = self.fluid.cell_centres[:, 2]
-        head = self.scene.fluid.density * self.scene.domain.gravity[2] * (z.max() - z.min())
+        head = self.fluid.rho * self.fluid.gravity()[2] * (z.max() - z.min())
         floor = self.dem.box()[0][2]
-        return (float(self.scene.fluid.inlet_at(self.t)), layer_pressure_drop(self.fluid) + head,
-                2.0 * float(np.mean(atoms.x[:, 2] - floor)))
+        inlet = math.nan if self.scene.fluid.case else float(self.scene.fluid.inlet_at(self.t))
+        return (inlet, layer_pressure_drop(self.fluid) + head,
+                2.0 * float(np.mean(atoms.x[:, 2] - floor)) if len(atoms.x) else math.nan)
 
     # -- output -------------------------------------------------------------------------
     def write_frame(self) -> None:
