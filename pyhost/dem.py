@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from pyhost.dem_input import Particles, input_lines, write_data
+from pyhost.failures import particles_lost
 from pyhost.liggghts import Liggghts
 
 FLUID_FIX = "fluid"
@@ -31,6 +32,7 @@ class SceneDem:
             lines.append(f"fix {FLUID_FIX} all external pf/array 1")
         script.write_text("\n".join(lines) + "\n")
         self.n = len(particles.radius)
+        self.scene, self.group, self.before = scene, particles.group, None    # for particles_lost
         self.fluid_force = fluid_force
         self.lmp = Liggghts(workdir)
         self.lmp.file(script)
@@ -42,13 +44,13 @@ class SceneDem:
 
     def _views(self) -> None:
         if self.lmp.nlocal != self.n:
-            raise RuntimeError(f"LIGGGHTS holds {self.lmp.nlocal} particles, the scene {self.n}: "
-                               "particles left the domain")
+            raise particles_lost(self)
         self.order = np.argsort(self.lmp.atom("id"))        # local index of particle k (id k + 1)
         self.identity = bool(np.all(self.order == np.arange(self.n)))
         self.x, self.v = self.lmp.atom("x"), self.lmp.atom("v")
 
     def run(self, steps: int) -> None:
+        self.before = (self.lmp.step * self.lmp.dt, *(a.copy() for a in self.state()))
         self.lmp.run(int(steps))
         self._views()
 
