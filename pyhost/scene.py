@@ -257,10 +257,11 @@ SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "flu
 
 def load_scene(path) -> Scene:
     """Read and validate a scene file; raises SceneError naming the file and the key."""
+    from pyhost.validate import check_raw, check_scene, read_text
     path = Path(path)
     file = str(path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(read_text(path))
     except FileNotFoundError:
         raise SceneError(f"{file}: no such scene file") from None
     except tomllib.TOMLDecodeError as exc:
@@ -271,6 +272,7 @@ def load_scene(path) -> Scene:
     for key in ("materials", "particles", "domain", "time"):
         if key not in data:
             raise SceneError(f"{file}: {key}: missing section")
+    check_raw(data, file)
     effects = _build(Effects, data.get("effects", {}), "effects", file)
     materials = {name: _build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
     for name, m in materials.items():
@@ -311,4 +313,6 @@ def load_scene(path) -> Scene:
     if fluid is not None and fluid.inlet_table:
         _inlet_table(fluid, file)
     output = _build(Output, data.get("output", {}), "output", file)
-    return Scene(path, effects, materials, particles, domain, time, walls, fluid, output)
+    scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output)
+    check_scene(scene)
+    return scene
