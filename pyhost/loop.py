@@ -22,6 +22,7 @@ from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys,
 from pyhost.contact_heat import evaluate, restitution_impulse
 from pyhost.contacts import ContactFinder
 from pyhost.dem_input import Particles, material_index
+from pyhost.outdir import write_atomic
 from pyhost.output import CsvLog, Progress, VtkSeries
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
@@ -238,7 +239,7 @@ class Coupling:
         summary = dict(self.totals, status=status, time=self.t, steps=self.step, sum_mcT_start=self.CT0,
                        sum_mcT_end=CT,
                        energy_balance_error=(CT - self.CT0 - self.totals["heat_from_walls"]) / self.CT0)
-        (self.out / "summary.json").write_text(json.dumps(summary, indent=1))
+        write_atomic(self.out / "summary.json", json.dumps(summary, indent=1))
         self.collisions.close()
         self.history.close()
         return summary

@@ -15,6 +15,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("case", type=Path, help="case folder holding case.toml")
     p.add_argument("--out", type=Path, default=None, help="output folder (default CASE/output)")
     p.add_argument("--test", action="store_true", help="smoke run: only time.test_end (default end/10)")
+    p.add_argument("--overwrite", action="store_true", help="replace the run already in the output folder")
 
 
 def resolved(scene) -> dict:
@@ -47,6 +48,7 @@ def run(args) -> int:
     from pyhost.dem import SceneDem
     from pyhost.dem_input import dem_collision_time, place_particles
     from pyhost.loop import Coupling
+    from pyhost.outdir import prepare_output, write_atomic
     from pyhost.scene import load_scene
 
     scene = load_scene(args.case / "case.toml")
@@ -55,10 +57,10 @@ def run(args) -> int:
         scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=end))
     effects = scene.effects_summary()
     out = args.out or args.case / "output"
-    out.mkdir(parents=True, exist_ok=True)
+    prepare_output(out, args.overwrite)
     print("scene:", json.dumps(resolved(scene), indent=1, default=str))
     print("active effects:", ", ".join(k for k, on in effects.items() if on) or "none (plain DEM)")
-    (out / "scene.json").write_text(json.dumps(resolved(scene), indent=1, default=str))
+    write_atomic(out / "scene.json", json.dumps(resolved(scene), indent=1, default=str))
     particles = place_particles(scene)
     t_c = dem_collision_time(scene, 1.0)
     if scene.time.dem_step > t_c / 20:
