@@ -7,7 +7,8 @@ Causes, tried in this order for the face the particle was heading to:
   DEM collision time, ``pyhost.dem_input.dem_collision_time``): contacts are missed or blow up;
 - tunnelling through a soft wall: the undamped Hertz overlap at that speed (DEM moduli)
   exceeds the radius, so the wall cannot stop it;
-- blow-out by the gas: leaving upwards through the top while the inlet blows.
+- blow-out by the gas: leaving upwards through the top while the inlet blows (tried first
+  for an open top).
 """
 from __future__ import annotations
 
@@ -48,6 +49,10 @@ def likely_cause(scene, group: int, x, v, t: float) -> str:
     speed = float(np.linalg.norm(v))
     face = heading(scene, x, v)
     walls = {w.plane: w for w in scene.walls}
+    blowing = scene.fluid is not None and scene.effects.fluid and face == "zhi" and float(scene.fluid.inlet_at(t)) > 0
+    gas = f"rising at {v[2]:.3g} m/s with the inlet at {float(scene.fluid.inlet_at(t)):.3g} m/s" if blowing else ""
+    if face not in walls and blowing:
+        return f"blown out by the gas through the open top (zhi): {gas}"
     if face not in walls:
         return (f"the box is open at {face} (no [[walls]] plane = \"{face}\", axis not periodic): "
                 f"a particle reaching it leaves the DEM")
@@ -66,9 +71,8 @@ def likely_cause(scene, group: int, x, v, t: float) -> str:
     if overlap > g.radius:
         return (f"tunnelling through the soft wall {face}: at {speed:.3g} m/s the DEM's Hertz overlap would "
                 f"reach {overlap:.3g} m, more than the radius {g.radius:g} m: raise materials' dem.youngs_modulus")
-    if scene.fluid is not None and scene.effects.fluid and face == "zhi":
-        return (f"blown out by the gas: rising at {v[2]:.3g} m/s with the inlet at "
-                f"{float(scene.fluid.inlet_at(t)):.3g} m/s")
+    if blowing:
+        return f"blown out by the gas, through the top wall: {gas}"
     return f"heading for the wall {face} at {speed:.3g} m/s, cause not recognised"
 
 

@@ -139,16 +139,14 @@ class FluidSolver:
                                              stderr=subprocess.STDOUT, env=foam_env(),
                                              start_new_session=True)
             except OSError as exc:
+                shutil.rmtree(link, ignore_errors=True)
                 raise FluidError(f"cannot start the fluid solver {command[0]}: {exc.strerror}") from None
         self._busy = True
-        centres, volumes = [], []
-        for rank in range(self.nprocs):
-            fd_in = self._open_writer(link / f"rank{rank}.in")
-            fd_out = os.open(link / f"rank{rank}.out", os.O_RDONLY | os.O_NONBLOCK)
-            self._fds.append((fd_in, fd_out))
-            nc = int(self._read(rank, np.int32, 1)[0])
-            centres.append(self._read(rank, np.float64, 3 * nc).reshape(nc, 3))
-            volumes.append(self._read(rank, np.float64, nc))
+        try:
+            centres, volumes = self._connect(link)
+        except BaseException:       # no solver, pipe or descriptor outlives a failed start
+            self.stop()
+            raise
         self.rank_cells = np.array([len(v) for v in volumes])
         self.offsets = np.concatenate([[0], np.cumsum(self.rank_cells)])
         self.cell_centres = np.concatenate(centres)
@@ -157,6 +155,18 @@ class FluidSolver:
         self._alpha, self._ksl, self._us = np.ones(n), np.zeros(n), np.zeros((n, 3))
         self._busy = False
         return self
+
+    def _connect(self, link: Path) -> tuple[list, list]:
+        """Open each rank's pipes; its cell centres and volumes."""
+        centres, volumes = [], []
+        for rank in range(self.nprocs):
+            fd_in = self._open_writer(link / f"rank{rank}.in")
+            fd_out = os.open(link / f"rank{rank}.out", os.O_RDONLY | os.O_NONBLOCK)
+            self._fds.append((fd_in, fd_out))
+            nc = int(self._read(rank, np.int32, 1)[0])
+            centres.append(self._read(rank, np.float64, 3 * nc).reshape(nc, 3))
+            volumes.append(self._read(rank, np.float64, nc))
+        return centres, volumes
 
     def stop(self) -> None:
         """End the solver (it writes nothing more) and remove the pipes. A solver in the
@@ -189,11 +199,7 @@ class FluidSolver:
         self.proc.wait()
 
     def __enter__(self) -> "FluidSolver":
-        try:
-            return self.start()
-        except BaseException:
-            self.stop()
-            raise
+        return self.start()
 
     def __exit__(self, *exc) -> None:
         self.stop()
