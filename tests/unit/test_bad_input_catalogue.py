@@ -365,3 +365,12 @@ def test_fluid_mesh_rebuilt_when_its_inputs_change(tmp_path):
     assert (mesh / "owner").exists()               # same inputs: the mesh is kept
     make((2, 2, 3))
     assert not mesh.exists()                       # other cells: built anew by the next start
+
+
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_debug_shows_the_error_itself(where, tmp_path):
+    """--debug (before or after the command) lets the exception through, for its traceback."""
+    from pyhost.scene import SceneError
+    args = ["run", str(tmp_path / "missing")]
+    with pytest.raises(SceneError, match="no such scene file"):
+        main(["--debug", *args] if where == "before" else [*args, "--debug"])
