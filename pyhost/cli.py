@@ -2,7 +2,10 @@
 
 Each command lives in ``pyhost/commands/<name>.py`` and exposes ``HELP`` (one line),
 ``add_arguments(parser)`` and ``run(args) -> int``. Commands are registered by name in
-``COMMANDS``; errors the user can fix (``UserError``, ``ValueError``) print one line and exit 2.
+``COMMANDS``. A command ends with one line on stderr and the exit code of
+:mod:`pyhost.exitcodes` (docs/exit-codes.md): 2 for errors the user can fix (``UserError``,
+``ValueError``), 3 for a failed simulation, 128 + n for signal n (:mod:`pyhost.signals`);
+a traceback only with ``--debug``.
 """
 from __future__ import annotations
 
@@ -10,6 +13,9 @@ import argparse
 import importlib
 import re
 import sys
+
+from pyhost.exitcodes import classify
+from pyhost.signals import stopping
 
 COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench")
 
@@ -34,12 +40,15 @@ def build_parser() -> argparse.ArgumentParser:
         prog="python -m pyhost",
         description="Heat conducted between colliding particles (Kosinski et al. 2014).",
     )
+    debug = dict(action="store_true", help="show the traceback of an error")
+    parser.add_argument("--debug", **debug)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=Parser)
     for name in COMMANDS:
         module = importlib.import_module(f"pyhost.commands.{name}")
         p = sub.add_parser(name, help=module.HELP, description=module.HELP,
                            formatter_class=argparse.ArgumentDefaultsHelpFormatter)
         module.add_arguments(p)
+        p.add_argument("--debug", default=argparse.SUPPRESS, **{**debug, "help": argparse.SUPPRESS})
         p.set_defaults(_run=module.run)
     return parser
 
@@ -48,12 +57,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args._run(args) or 0)
-    except (UserError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except RuntimeError as exc:
-        if not type(exc).__module__.startswith("pyhost."):      # an engine's error, e.g. LiggghtsError
+        with stopping():
+            return int(args._run(args) or 0)
+    except BaseException as exc:
+        if args.debug or isinstance(exc, SystemExit):
             raise
-        print(f"error: {type(exc).__name__}: {exc}", file=sys.stderr)
-        return 2
+        code, message = classify(exc)
+        print(f"error: {message}", file=sys.stderr)
+        return code

@@ -53,6 +53,11 @@ class DemHertz:
         root = np.sqrt(Rstar * delta)
         return 4.0 / 3.0 * self.Ystar * root * delta + self._damping * np.sqrt(2.0 * self.Ystar * root * mstar) * ddelta
 
+    def max_overlap(self, v, Rstar, mstar):
+        """Largest overlap [m] of an undamped collision at normal speed v [m/s]: the kinetic
+        energy m* v^2 / 2 equals the Hertz energy (8/15) Y* R*^(1/2) delta^(5/2)."""
+        return (15.0 * mstar * np.asarray(v, float) ** 2 / (16.0 * self.Ystar * np.sqrt(Rstar))) ** 0.4
+
     def impact_speed(self, delta, ddelta, Rstar, mstar, steps: int = 8, window: float | None = None):
         """Normal impact speed [m/s] of contacts first seen at overlap delta [m] with overlap
         rate ddelta [m/s] (> 0 while approaching): the DEM's law integrated back to delta = 0.

@@ -11,6 +11,7 @@ the six faces (xlo, xhi, ylo, yhi, zlo, zhi) gets one boundary kind:
 """
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +30,10 @@ def _dict(path: Path, class_: str = "dictionary") -> FoamFile:
     f.class_ = class_
     f.object_ = path.name
     return f
+
+
+def _text(path: Path) -> str | None:
+    return path.read_text() if path.is_file() else None
 
 
 def _bc(kind, field: str) -> dict:
@@ -66,12 +71,15 @@ def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, n
     corners = [[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
                for k, j, i in [(0, 0, 0), (0, 0, 1), (0, 1, 1), (0, 1, 0),
                                (1, 0, 0), (1, 0, 1), (1, 1, 1), (1, 1, 0)]]
+    old_mesh = _text(path / "system" / "blockMeshDict")
     mesh = _dict(path / "system" / "blockMeshDict")
     mesh["convertToMeters"] = 1
     mesh["vertices"] = np.array(corners)
     mesh["blocks"] = ["hex", list(range(8)), list(map(int, cells)), "simpleGrading", [1, 1, 1]]
     mesh["boundary"] = [(face, {"type": "wall" if boundaries[face] in ("wall", "slip") else "patch",
                                 "faces": [list(FACES[face])]}) for face in FACES]
+    if _text(path / "system" / "blockMeshDict") != old_mesh:    # a mesh of other inputs: build anew
+        shutil.rmtree(path / "constant" / "polyMesh", ignore_errors=True)
 
     control = _dict(path / "system" / "controlDict")
     control.update({

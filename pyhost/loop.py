@@ -30,7 +30,9 @@ import numpy as np
 from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat
 from pyhost.contact_heat import evaluate, restitution_impulse
 from pyhost.dem import Dem
+from pyhost.failures import particles_lost
 from pyhost.liggghts import LiggghtsError
+from pyhost.outdir import write_atomic
 from pyhost.output import CsvLog, Progress, VtkSeries
 from pyhost.script import ScriptError, parse_run
 
@@ -69,13 +71,15 @@ class Coupling:
     """
 
     def __init__(self, scene, dem: Dem, out: Path, *, type_material, groups, walls, initial_T, fluid=None,
-                 end: float | None = None, progress_every: float = 5.0):
+                 end: float | None = None, progress_every: float = 5.0, keep_all: np.ndarray | None = None):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
         self.materials = list(scene.materials.values())
         self.type_material = np.asarray(type_material, int)
         self.group_names, self.group_of = groups
         self.initial_T = initial_T
+        self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
+        self.before = None
         self.walls = walls
         self.wall_index = {w.fix: k for k, w in enumerate(walls)}
         self.T_wall = np.array([w.temperature if self.effects["wall_heat"] else np.nan for w in walls])
@@ -122,7 +126,12 @@ class Coupling:
         while n > 0:
             step = self.dem.step - self.t0_step
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
+            if self.keep_all is not None:
+                a = self.dem.atoms(False)
+                self.before = (self.t, a.id.copy(), a.x.copy(), a.v.copy())
             self.dem.run(chunk)
+            if self.keep_all is not None and self.dem.lmp.nlocal < len(self.before[1]):
+                self.lost()
             n -= chunk
             self.steps += chunk
             step += chunk
@@ -139,6 +148,11 @@ class Coupling:
             self.progress.update(self.t, f", {self.totals['collisions']} collisions")
         if self.heat:
             self.track_particles(self.dem.atoms(True))
+
+    def lost(self):
+        """A box scene lost particles (through an open face, a soft wall, or blown out)."""
+        gone = np.setdiff1d(self.before[1], self.dem.atoms(False).id)
+        raise particles_lost(self.scene, gone, self.before, self.dem.step * self.dem.dt, self.keep_all)
 
     def resync(self) -> None:
         """Before each run: heat content that the script's own commands changed since the last
@@ -383,7 +397,7 @@ class Coupling:
             summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=(    # relative to all
                 CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]      # that came in
                 - t["energy_set_by_script"]) / max(self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"]), 1e-300))
-        (self.out / "summary.json").write_text(json.dumps(summary, indent=1))
+        write_atomic(self.out / "summary.json", json.dumps(summary, indent=1))
         self.collisions.close()
         self.history.close()
         return summary

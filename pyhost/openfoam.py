@@ -7,11 +7,17 @@ exchanges per-particle and per-cell data with each rank through two named pipes 
 a force with a drag law chosen by name (:mod:`pyhost.drag`). Every exchange is checked: a
 solver that diverges or stops raises :class:`FluidError` carrying the tail of its log.
 
+Nothing waits on the solver for ever: every open, read and write of the pipes has a deadline
+(``timeout``, default ``$COLLHEAT_FLUID_TIMEOUT`` or 120 s), and a solver that never connects,
+dies, or stops answering (e.g. stopped by SIGSTOP) ends with a FluidError saying which and
+after how long. The solver runs in a session of its own, so a terminal's Ctrl-C reaches only
+the host, which then ends the solver (:meth:`FluidSolver.stop`).
+
 Units: SI throughout. The solver's pressure is kinematic (m^2/s^2); this module gives Pa.
 """
 from __future__ import annotations
 
-import fcntl
+import functools
 import os
 import select
 import shutil
@@ -28,10 +34,23 @@ from pyhost import drag as drag_laws
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
 SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[1] / ".setup" / "bin" / "collheatFoam"))
 LOCATE, ADVANCE, FIELDS, WRITE, STOP = 1, 2, 3, 4, 5
+TIMEOUT = float(os.environ.get("COLLHEAT_FLUID_TIMEOUT", 120.0))   # s, see the module doc
 
 
 class FluidError(RuntimeError):
     """The fluid solver failed; the message ends with the tail of its log."""
+
+
+def _exchange(method):
+    """Marks a request/answer exchange: while one is under way the pipes hold half a
+    message, so :meth:`FluidSolver.stop` must end the solver instead of asking it to stop."""
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        self._busy = True
+        result = method(self, *args, **kwargs)
+        self._busy = False
+        return result
+    return wrapper
 
 
 def foam_env() -> dict:
@@ -77,7 +96,7 @@ class FluidSolver:
     """
 
     def __init__(self, case: str | os.PathLike, *, nprocs: int = 1, drag: str = "gidaspow",
-                 alpha_min: float = 0.3, timeout: float = 120.0):
+                 alpha_min: float = 0.3, timeout: float = TIMEOUT):
         self.case = Path(case).resolve()
         if not (self.case / "system" / "controlDict").is_file():
             raise FluidError(f"{self.case} is not an OpenFOAM case (no system/controlDict)")
@@ -92,6 +111,7 @@ class FluidSolver:
         self.log = self.case / "log.collheatFoam"
         self.proc: subprocess.Popen | None = None
         self._fds: list[tuple[int, int]] = []
+        self._busy = False
         self.time = 0.0
 
     # -- life cycle -------------------------------------------------------------------
@@ -114,8 +134,30 @@ class FluidSolver:
             os.mkfifo(link / f"rank{rank}.in")
             os.mkfifo(link / f"rank{rank}.out")
         with open(self.log, "w") as out:
-            self.proc = subprocess.Popen([*command, "-link", str(link)], stdout=out,
-                                         stderr=subprocess.STDOUT, env=foam_env())
+            try:
+                self.proc = subprocess.Popen([*command, "-link", str(link)], stdout=out,
+                                             stderr=subprocess.STDOUT, env=foam_env(),
+                                             start_new_session=True)
+            except OSError as exc:
+                shutil.rmtree(link, ignore_errors=True)
+                raise FluidError(f"cannot start the fluid solver {command[0]}: {exc.strerror}") from None
+        self._busy = True
+        try:
+            centres, volumes = self._connect(link)
+        except BaseException:       # no solver, pipe or descriptor outlives a failed start
+            self.stop()
+            raise
+        self.rank_cells = np.array([len(v) for v in volumes])
+        self.offsets = np.concatenate([[0], np.cumsum(self.rank_cells)])
+        self.cell_centres = np.concatenate(centres)
+        self.cell_volumes = np.concatenate(volumes)
+        n = len(self.cell_volumes)
+        self._alpha, self._ksl, self._us = np.ones(n), np.zeros(n), np.zeros((n, 3))
+        self._busy = False
+        return self
+
+    def _connect(self, link: Path) -> tuple[list, list]:
+        """Open each rank's pipes; its cell centres and volumes."""
         centres, volumes = [], []
         for rank in range(self.nprocs):
             fd_in = self._open_writer(link / f"rank{rank}.in")
@@ -124,20 +166,16 @@ class FluidSolver:
             nc = int(self._read(rank, np.int32, 1)[0])
             centres.append(self._read(rank, np.float64, 3 * nc).reshape(nc, 3))
             volumes.append(self._read(rank, np.float64, nc))
-        self.rank_cells = np.array([len(v) for v in volumes])
-        self.offsets = np.concatenate([[0], np.cumsum(self.rank_cells)])
-        self.cell_centres = np.concatenate(centres)
-        self.cell_volumes = np.concatenate(volumes)
-        n = len(self.cell_volumes)
-        self._alpha, self._ksl, self._us = np.ones(n), np.zeros(n), np.zeros((n, 3))
-        return self
+        return centres, volumes
 
     def stop(self) -> None:
-        """End the solver (it writes nothing more) and remove the pipes."""
+        """End the solver (it writes nothing more) and remove the pipes. A solver in the
+        middle of an exchange (the host was interrupted) or not answering is killed, with
+        every process of its session (mpirun's ranks)."""
         if self.proc is None:
             return
         try:
-            if self.proc.poll() is None:
+            if self.proc.poll() is None and not self._busy and _state(self.proc.pid) != "T":
                 for rank in range(self.nprocs):
                     self._send(rank, np.int32(STOP).tobytes())
                 for rank in range(self.nprocs):
@@ -148,18 +186,20 @@ class FluidSolver:
                 for fd in fds:
                     os.close(fd)
             self._fds = []
-            if self.proc.poll() is None:
-                self.proc.kill()
-                self.proc.wait()
+            self._kill()
             self.proc = None
             shutil.rmtree(self.case / ".link", ignore_errors=True)
 
-    def __enter__(self) -> "FluidSolver":
+    def _kill(self) -> None:
+        """SIGKILL the solver's session (also stopped processes and mpirun's ranks) and reap it."""
         try:
-            return self.start()
-        except BaseException:
-            self.stop()
-            raise
+            os.killpg(self.proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        self.proc.wait()
+
+    def __enter__(self) -> "FluidSolver":
+        return self.start()
 
     def __exit__(self, *exc) -> None:
         self.stop()
@@ -193,6 +233,7 @@ class FluidSolver:
         self._us = np.divide(kv, ksum[:, None], out=np.zeros_like(kv), where=ksum[:, None] > 0)
         return k[:, None] * slip - (vp * self.rho)[:, None] * gradp
 
+    @_exchange
     def locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Cell of each position (global index over ranks), fluid velocity (m/s) and kinematic
         pressure gradient (m/s^2) there, interpolated as controlDict's
@@ -217,6 +258,7 @@ class FluidSolver:
                              f"at {x[lost[0]].tolist()} m")
         return cell, u, gradp
 
+    @_exchange
     def advance(self, duration: float, steps: int = 1) -> float:
         """Advance the fluid by ``duration`` (s) in ``steps`` equal time steps with the
         particle fields of the last :meth:`particle_forces`; returns the fluid time (s)."""
@@ -239,6 +281,7 @@ class FluidSolver:
         self.advance(duration, steps)
         return forces
 
+    @_exchange
     def fields(self) -> tuple[np.ndarray, np.ndarray]:
         """Pressure (Pa) and velocity (m/s) of every cell, in the order of ``cell_centres``."""
         for rank in range(self.nprocs):
@@ -255,6 +298,7 @@ class FluidSolver:
         """Fluid volume fraction of every cell as last sent (-)."""
         return self._alpha
 
+    @_exchange
     def write(self) -> float:
         """Write all fields at the current fluid time; returns that time (s)."""
         for rank in range(self.nprocs):
@@ -264,13 +308,23 @@ class FluidSolver:
         return self.time
 
     # -- pipes ------------------------------------------------------------------------
-    def _failed(self, what: str) -> FluidError:
-        if self.proc is not None and self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait()
-        rc = None if self.proc is None else self.proc.returncode
+    def _failed(self, what: str, waited: float | None = None) -> FluidError:
+        """The error for a solver that ended while ``what``, or (``waited`` seconds given)
+        one still alive that did not answer in time, which is then ended."""
+        if waited is not None and self.proc.poll() is None:
+            state = {"T": "stopped (SIGSTOP or a debugger)", "Z": "exiting"}.get(
+                _state(self.proc.pid), "running but silent")
+            self._kill()
+            return FluidError(f"the fluid solver did not answer within {waited:.1f} s while {what}: "
+                              f"it was {state}, and the host ended it (time-out: timeout argument or "
+                              f"COLLHEAT_FLUID_TIMEOUT); end of {self.log}:\n{log_tail(self.log)}")
+        try:                    # the pipe closed: give the solver a moment to end by itself
+            self.proc.wait(timeout=2.0)
+        except subprocess.TimeoutExpired:
+            self._kill()
+        rc = self.proc.returncode
         how = f"exit code {rc}"
-        if rc is not None and rc < 0:
+        if rc < 0:
             how = f"killed by {signal.Signals(-rc).name}"
             if -rc == signal.SIGFPE:
                 how += ": a floating point exception, the run diverged"
@@ -278,23 +332,33 @@ class FluidSolver:
                           f"end of {self.log}:\n{log_tail(self.log)}")
 
     def _open_writer(self, path: Path) -> int:
-        deadline = time.monotonic() + self.timeout
+        """The host's end of a request pipe, non-blocking: writes wait in :meth:`_send`."""
+        start = time.monotonic()
         while True:
             try:
-                fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK)
-                break
+                return os.open(path, os.O_WRONLY | os.O_NONBLOCK)
             except OSError:  # ENXIO: the solver has not opened its end yet
-                if self.proc.poll() is not None or time.monotonic() > deadline:
+                if self.proc.poll() is not None:
                     raise self._failed("starting") from None
+                if time.monotonic() - start > self.timeout:
+                    raise self._failed("starting: it never opened the link (start time-out)",
+                                       time.monotonic() - start) from None
                 time.sleep(0.005)
-        fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) & ~os.O_NONBLOCK)
-        return fd
 
     def _send(self, rank: int, data: bytes) -> None:
+        view = memoryview(data)
+        start = time.monotonic()
         try:
-            view = memoryview(data)
+            fd = self._fds[rank][0]
             while view:
-                view = view[os.write(self._fds[rank][0], view):]
+                try:
+                    view = view[os.write(fd, view):]
+                except BlockingIOError:       # the pipe is full: the solver is not reading
+                    if self.proc.poll() is not None:
+                        raise self._failed("receiving a request") from None
+                    if time.monotonic() - start > self.timeout:
+                        raise self._failed("receiving a request", time.monotonic() - start) from None
+                    select.select([], [fd], [], 0.5)
         except (BrokenPipeError, IndexError):
             raise self._failed("receiving a request") from None
 
@@ -302,12 +366,14 @@ class FluidSolver:
         fd = self._fds[rank][1]
         need = np.dtype(dtype).itemsize * count
         chunks, got = [], 0
-        deadline = time.monotonic() + self.timeout
+        start = time.monotonic()
         while got < need:
             ready, _, _ = select.select([fd], [], [], 0.5)
             if not ready:
-                if self.proc.poll() is not None or time.monotonic() > deadline:
+                if self.proc.poll() is not None:
                     raise self._failed("computing")
+                if time.monotonic() - start > self.timeout:
+                    raise self._failed("computing", time.monotonic() - start)
                 continue
             chunk = os.read(fd, need - got)
             if not chunk:
@@ -315,6 +381,14 @@ class FluidSolver:
             chunks.append(chunk)
             got += len(chunk)
         return np.frombuffer(b"".join(chunks), dtype=dtype)
+
+
+def _state(pid: int) -> str:
+    """One-letter state of a process (R, S, T stopped, Z zombie...), '' if unknown."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return ""
 
 
 def _value(entry) -> float:

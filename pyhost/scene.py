@@ -285,10 +285,11 @@ SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "flu
 
 def load_scene(path) -> Scene:
     """Read and validate a scene file; raises SceneError naming the file and the key."""
+    from pyhost.validate import check_raw, check_scene, read_text
     path = Path(path)
     file = str(path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(read_text(path))
     except FileNotFoundError:
         raise SceneError(f"{file}: no such scene file") from None
     except tomllib.TOMLDecodeError as exc:
@@ -308,6 +309,7 @@ def load_scene(path) -> Scene:
                 raise SceneError(f"{file}: {key}: not used with dem.script (the script places the particles "
                                  "and sets the domain): remove it")
         _script_keys(dem, path, file)
+    check_raw(data, file)
     effects = _build(Effects, data.get("effects", {}), "effects", file)
     if not isinstance(data["materials"], dict) or not data["materials"]:
         raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
@@ -349,7 +351,9 @@ def load_scene(path) -> Scene:
     if fluid is not None and fluid.inlet_table:
         _inlet_table(fluid, file)
     output = _build(Output, data.get("output", {}), "output", file)
-    return Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem)
+    scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem)
+    check_scene(scene)
+    return scene
 
 
 def _script_keys(dem, path, file):

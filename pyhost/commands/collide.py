@@ -4,12 +4,17 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
+import warnings
 
 import numpy as np
 
 from plugins.heat import MODELS, PAPER_SET, Pair, collide
 from plugins.heat.exact import OUTPUT_KEYS
 from plugins.heat.fast import REGIMES, collide_fast
+from plugins.heat.validity import check_scales
+from plugins.heat.validity import flags as validity_flags
+from pyhost.cli import UserError
 
 HELP = "heat conducted and rebound of head-on collisions (models A, B, C; SI units)"
 
@@ -73,8 +78,32 @@ def evaluate(args) -> list[dict]:
     return rows
 
 
+def checked(args) -> list[dict]:
+    """The rows of ``evaluate``, each with the flags of plugins.heat.validity; UserError for
+    a pair or a speed outside double precision (an output would be NaN or Infinity)."""
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        pair = pair_from_args(args)
+        check_scales(pair)
+        try:
+            rows = evaluate(args)
+        except ArithmeticError as exc:
+            raise UserError(f"--v0 {args.v0}: the collision is outside double precision ({exc})") from None
+    for row in rows:
+        found = validity_flags(pair, row["v0"], row, args.method)
+        if "overflow" in found:
+            bad = [k for k, v in row.items() if isinstance(v, float) and not math.isfinite(v)]
+            raise UserError(f"--v0 {row['v0']:g}, --dT {args.dT:g}: {', '.join(bad)} overflow (not finite in "
+                            f"double precision); outside the range of the models")
+        row["flags"] = row.get("flags", []) + found
+        if found:
+            print(f"warning: model {row['model']}, v0 = {row['v0']:g} m/s: {', '.join(found)} "
+                  f"(plugins/heat/validity.py)", file=sys.stderr)
+    return rows
+
+
 def run(args) -> int:
-    rows = evaluate(args)
+    rows = checked(args)
     if args.json:
         print(json.dumps(rows[0] if len(rows) == 1 else rows, indent=1))
         return 0

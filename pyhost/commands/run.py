@@ -19,6 +19,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("case", type=Path, help="case folder holding case.toml")
     p.add_argument("--out", type=Path, default=None, help="output folder (default CASE/output)")
     p.add_argument("--test", action="store_true", help="smoke run: only time.test_end (default end/10)")
+    p.add_argument("--overwrite", action="store_true", help="replace the run already in the output folder")
 
 
 def resolved(scene) -> dict:
@@ -76,7 +77,7 @@ def box_world(scene, out: Path, fluid_force: bool):
     return script, dict(type_material=[-1] + list(range(len(index))),
                         groups=(names, lambda atoms: group_by_id[atoms.id]),
                         initial_T=lambda atoms, new: T_by_id[atoms.id[new]],
-                        walls_of=lambda dem: walls)
+                        walls_of=lambda dem: walls, keep_all=group_by_id)
 
 
 def user_script(scene):
@@ -161,6 +162,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
 
 
 def run(args) -> int:
+    from pyhost.outdir import prepare_output, write_atomic
     from pyhost.scene import load_scene
 
     scene = load_scene(args.case / "case.toml")
@@ -169,10 +171,10 @@ def run(args) -> int:
         scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=end))
     effects = scene.effects_summary()
     out = (args.out or args.case / "output").resolve()
-    out.mkdir(parents=True, exist_ok=True)
+    prepare_output(out, args.overwrite)
     print("scene:", json.dumps(resolved(scene), indent=1, default=str))
     print("active effects:", ", ".join(k for k, on in effects.items() if on) or "none (plain DEM)")
-    (out / "scene.json").write_text(json.dumps(resolved(scene), indent=1, default=str))
+    write_atomic(out / "scene.json", json.dumps(resolved(scene), indent=1, default=str))
     summary = simulate(scene, out, test=args.test)
     print("summary:", json.dumps(summary, indent=1))
     if scene.output.pictures:        # own process: see pyhost/commands/pictures.py

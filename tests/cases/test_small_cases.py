@@ -75,12 +75,12 @@ def test_hot_cold_box_smoke_conserves_and_converges(tmp_path):
     assert (tmp_path / "particles.png").stat().st_size > 10000
 
 
-def test_engine_error_is_one_clear_message_and_exit_2(tmp_path):
+def test_particle_outside_the_box_is_refused_before_liggghts(tmp_path):
     text = (CASES / "two-particles" / "case.toml").read_text()
     (tmp_path / "case.toml").write_text(text.replace("[[0.045, 0.005, 0.01]]", "[[0.5, 0.005, 0.01]]"))
     r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 2
-    assert "LiggghtsError" in r.stderr and "ERROR" in r.stderr and "Traceback" not in r.stderr
+    assert "particles[0].positions[0]" in r.stderr and "outside the box" in r.stderr and "Traceback" not in r.stderr
 
 
 class Interrupting:

@@ -1,0 +1,90 @@
+"""Why a DEM run lost a particle: which one, where and how fast it was last seen, and the
+likely cause, told from the scene (exit code 3, docs/exit-codes.md).
+
+Causes, tried in this order for the face the particle was heading to:
+- an open face (no wall, not periodic): nothing holds the particle in;
+- a DEM step too long for the collision at the particle's speed (fewer than 10 steps per
+  DEM collision time, ``pyhost.dem_input.dem_collision_time``): contacts are missed or blow up;
+- tunnelling through a soft wall: the undamped Hertz overlap at that speed (DEM moduli)
+  exceeds the radius, so the wall cannot stop it;
+- blow-out by the gas: leaving upwards through the top while the inlet blows (tried first
+  for an open top).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from pyhost.collisions import DemHertz
+from pyhost.dem_input import dem_collision_time
+from pyhost.exitcodes import SimulationFailed
+
+FACES = ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")
+STEPS_PER_COLLISION = 10        # fewer DEM steps than this per collision: under-resolved
+
+
+class ParticlesLost(SimulationFailed):
+    """Particles left the DEM's box. ``ids`` (1-based), ``position`` [m] and ``velocity``
+    [m/s] where first lost one was last seen, ``time`` [s] of that sight, ``cause`` in words."""
+
+    def __init__(self, message, ids, position, velocity, time, cause):
+        super().__init__(message)
+        self.ids, self.position, self.velocity, self.time, self.cause = ids, position, velocity, time, cause
+
+
+def heading(scene, x, v) -> str:
+    """The face of the box a particle at x moving at v reaches first (periodic axes skipped)."""
+    box = np.asarray(scene.domain.box, float)
+    best, face = np.inf, FACES[-1]
+    for a in range(3):
+        if scene.domain.periodic[a] or v[a] == 0:
+            continue
+        side = 1 if v[a] > 0 else 0
+        t = (box[2 * a + side] - x[a]) / v[a]
+        if t < best:
+            best, face = t, FACES[2 * a + side]
+    return face
+
+
+def likely_cause(scene, group: int, x, v, t: float) -> str:
+    speed = float(np.linalg.norm(v))
+    face = heading(scene, x, v)
+    walls = {w.plane: w for w in scene.walls}
+    blowing = scene.fluid is not None and scene.effects.fluid and face == "zhi" and float(scene.fluid.inlet_at(t)) > 0
+    gas = f"rising at {v[2]:.3g} m/s with the inlet at {float(scene.fluid.inlet_at(t)):.3g} m/s" if blowing else ""
+    if face not in walls and blowing:
+        return f"blown out by the gas through the open top (zhi): {gas}"
+    if face not in walls:
+        return (f"the box is open at {face} (no [[walls]] plane = \"{face}\", axis not periodic): "
+                f"a particle reaching it leaves the DEM")
+    dt = scene.time.dem_step
+    t_c = dem_collision_time(scene, max(speed, 1e-12))
+    if dt * STEPS_PER_COLLISION > t_c:
+        return (f"time.dem_step = {dt:g} s against a DEM collision time of {t_c:.3g} s at {speed:.3g} m/s "
+                f"({t_c / dt:.1f} steps per collision, need >= {STEPS_PER_COLLISION}): "
+                f"use dem_step <= {t_c / 20:.2g} s")
+    g = scene.particles[group]
+    m, w = scene.materials[g.material].dem, scene.materials[walls[face].material].dem
+    law = DemHertz(1.0 / ((1 - m.poisson_ratio**2) / m.youngs_modulus + (1 - w.poisson_ratio**2) / w.youngs_modulus),
+                   1.0)
+    mass = 4.0 / 3.0 * np.pi * g.radius**3 * scene.materials[g.material].density
+    overlap = float(law.max_overlap(speed, g.radius, mass))
+    if overlap > g.radius:
+        return (f"tunnelling through the soft wall {face}: at {speed:.3g} m/s the DEM's Hertz overlap would "
+                f"reach {overlap:.3g} m, more than the radius {g.radius:g} m: raise materials' dem.youngs_modulus")
+    if blowing:
+        return f"blown out by the gas, through the top wall: {gas}"
+    return f"heading for the wall {face} at {speed:.3g} m/s, cause not recognised"
+
+
+def particles_lost(scene, lost_ids, before, t_now: float, group) -> ParticlesLost:
+    """The error for a box scene whose DEM holds fewer particles than it placed: ``lost_ids``
+    (atom ids), ``before`` = (t, ids, x, v) at the last check, ``group`` of each id."""
+    ids = np.asarray(lost_ids)
+    t, known, x, v = before
+    k = int(np.flatnonzero(known == ids[0])[0])
+    cause = likely_cause(scene, int(group[ids[0]]), x[k], v[k], t)
+    return ParticlesLost(
+        f"{len(ids)} particle(s) left the domain between t = {t:g} s and t = {t_now:g} s, "
+        f"ids {ids[:10].tolist()}{' ...' if len(ids) > 10 else ''}; particle {ids[0]} last seen at "
+        f"x = {np.round(x[k], 9).tolist()} m, v = {np.round(v[k], 6).tolist()} m/s; likely cause: {cause}",
+        ids, x[k], v[k], t, cause)

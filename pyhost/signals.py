@@ -1,0 +1,45 @@
+"""Interrupts: SIGINT, SIGTERM and SIGHUP all stop a command the same clean way.
+
+Inside ``stopping()`` each of them raises :class:`Interrupted` in the main thread, which
+unwinds like any error: the coupling loop writes summary.json with where and why it stopped,
+the engines are closed, the fluid solver (in its own session, see pyhost.openfoam) is ended,
+and the command exits with 128 + the signal's number (130, 143, 129). A second signal during
+that clean-up is ignored, so the clean-up is not cut short.
+"""
+from __future__ import annotations
+
+import contextlib
+import signal
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+class Interrupted(BaseException):
+    """A stop asked for by a signal. A BaseException, as KeyboardInterrupt: no ``except
+    Exception`` of the code it passes through takes it for an error to handle."""
+
+    def __init__(self, signum: int):
+        self.signum = signum
+        super().__init__(f"{signal.Signals(signum).name} received")
+
+    @property
+    def exit_code(self) -> int:
+        return 128 + self.signum
+
+
+@contextlib.contextmanager
+def stopping():
+    """Turn the first of SIGINT, SIGTERM, SIGHUP into :class:`Interrupted`; ignore the rest."""
+    first = []
+
+    def handler(signum, frame):
+        if not first:
+            first.append(signum)
+            raise Interrupted(signum)
+
+    old = {s: signal.signal(s, handler) for s in SIGNALS}
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)

@@ -1,0 +1,376 @@
+"""A catalogue of bad inputs: each ends with its exit code (docs/exit-codes.md) and one line
+naming the file and the key (or the option), never a traceback, and nothing written where a
+run would write. Scene and CLI entries run in process in seconds (refused before any engine
+starts); entries needing a real engine are in tests/engines/test_engine_fault_catalogue.py."""
+import copy
+import json
+import resource
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import tomli_w
+
+from pyhost.cli import main
+
+STEEL = dict(density=7800.0, youngs_modulus=210e9, poisson_ratio=0.3, yield_stress=300e6, heat_capacity=470.0,
+             conductivity=45.0, dem=dict(youngs_modulus=2e8, restitution=0.9, poisson_ratio=0.3))
+BASE = {   # cases/two-particles, shortened
+    "effects": {"contact_heat": "A", "heat_path": "exact"},
+    "materials": {"steel": STEEL},
+    "particles": [dict(material="steel", count=1, radius=2e-3, temperature=400.0, positions=[[0.045, 0.005, 0.01]],
+                       velocity=[0.2, 0.0, 0.0]),
+                  dict(material="steel", count=1, radius=2e-3, temperature=300.0, positions=[[0.0492, 0.005, 0.01]],
+                       velocity=[-0.2, 0.0, 0.0])],
+    "domain": {"box": [0.0, 0.1, 0.0, 0.01, 0.0, 0.02], "gravity": [0.0, 0.0, 0.0]},
+    "time": {"dem_step": 2e-7, "end": 2e-3},
+    "output": {"every": 2e-4, "pictures": False},
+}
+NAN, INF = float("nan"), float("inf")
+
+
+def setter(path, value):
+    """A change of the scene: the value at a dotted path (ints index lists)."""
+    def change(scene):
+        *head, last = path
+        node = scene
+        for key in head:
+            node = node[key]
+        node[last] = value
+    return change
+
+
+def remove(path):
+    def change(scene):
+        *head, last = path
+        node = scene
+        for key in head:
+            node = node[key]
+        del node[last]
+    return change
+
+
+def group(**values):
+    """Replace the particle groups by one region group of these values."""
+    g = dict(material="steel", count=10, radius=1e-3, temperature=300.0, region=[0.0, 0.02, 0.0, 0.01, 0.0, 0.02])
+    g.update(values)
+    return setter(("particles",), [g])
+
+
+def fluid(**values):
+    def change(scene):
+        scene["effects"]["fluid"] = True
+        scene["fluid"] = dict(values)
+    return change
+
+
+def both(*changes):
+    def change(scene):
+        for c in changes:
+            c(scene)
+    return change
+
+
+P0 = ("particles", 0)
+SCENES = {   # id: (change, words the one-line message must hold)
+    "materials is a number": (setter(("materials",), 5), ["materials"]),
+    "walls is a number": (setter(("walls",), 5), ["walls"]),
+    "a material is a number": (setter(("materials", "steel"), 5), ["materials.steel"]),
+    "flat positions": (setter(P0 + ("positions",), [0.045, 0.005, 0.01]), ["particles[0].positions"]),
+    "periodic as strings": (setter(("domain", "periodic"), ["no", "no", "no"]), ["domain.periodic", "booleans"]),
+    "periodic too short": (setter(("domain", "periodic"), [True, True]), ["domain.periodic"]),
+    "gravity with NaN": (setter(("domain", "gravity"), [0.0, 0.0, NAN]), ["domain.gravity[2]", "finite"]),
+    "gravity infinite": (setter(("domain", "gravity"), [INF, 0.0, 0.0]), ["domain.gravity[0]", "finite"]),
+    "box infinite": (setter(("domain", "box"), [0.0, INF, 0.0, 0.01, 0.0, 0.02]), ["domain.box[1]"]),
+    "position NaN": (setter(P0 + ("positions",), [[NAN, 0.005, 0.01]]), ["particles[0].positions[0][0]"]),
+    "velocity infinite": (setter(P0 + ("velocity",), [INF, 0.0, 0.0]), ["particles[0].velocity[0]"]),
+    "velocity of two": (setter(P0 + ("velocity",), [1.0, 0.0]), ["particles[0].velocity"]),
+    "wall on a periodic axis": (both(setter(("domain", "periodic"), [True, False, False]),
+                                     setter(("walls",), [dict(plane="xlo", material="steel")])),
+                                ["walls[0].plane", "periodic"]),
+    "alpha_min 2": (fluid(alpha_min=2.0), ["fluid.alpha_min"]),
+    "alpha_min 1": (fluid(alpha_min=1.0), ["fluid.alpha_min"]),
+    "alpha_min 0": (fluid(alpha_min=0.0), ["fluid.alpha_min"]),
+    "output.every below the step": (setter(("output", "every"), 1e-8), ["output.every", "dem_step"]),
+    "test_end beyond end": (setter(("time", "test_end"), 1.0), ["time.test_end"]),
+    "2.5e9 particles": (group(count=2_500_000_000, region=[0.0, 0.1, 0.0, 0.01, 0.0, 0.02]), ["particles", "32-bit"]),
+    "particles overlapping 3 mm": (setter(("particles", 1, "positions"), [[0.046, 0.005, 0.01]]),
+                                   ["particles[0].positions[0]", "particles[1].positions[0]", "overlap"]),
+    "overlap across a periodic face": (both(setter(("domain", "periodic"), [True, False, False]),
+                                            setter(P0 + ("positions",), [[0.0005, 0.005, 0.01]]),
+                                            setter(("particles", 1, "positions"), [[0.0995, 0.005, 0.01]])),
+                                       ["overlap", "periodic images"]),
+    "bead 1 mm inside a wall": (both(setter(("walls",), [dict(plane="zlo", material="steel")]),
+                                     setter(P0 + ("positions",), [[0.045, 0.005, 0.001]])),
+                                ["particles[0].positions[0]", "wall zlo"]),
+    "position outside the box": (setter(P0 + ("positions",), [[0.5, 0.005, 0.01]]),
+                                 ["particles[0].positions[0]", "outside the box"]),
+    "region outside the box": (group(region=[0.0, 0.02, 0.0, 0.01, 0.0, 0.05]), ["particles[0].region", "inside the box"]),
+    "region wider than a periodic box": (both(setter(("domain", "periodic"), [True, True, True]),
+                                              group(region=[-0.01, 0.11, 0.0, 0.01, 0.0, 0.02])),
+                                         ["particles[0].region"]),
+    "region too small for the count": (group(count=1000), ["particles[0].region", "holds"]),
+    "DEM step too long for the speed": (setter(("time", "dem_step"), 5e-5), ["time.dem_step", "use dem_step <="]),
+    "DEM step too long for the spread": (both(setter(P0 + ("velocity_spread",), 50.0), setter(("time", "dem_step"), 1e-5)),
+                                         ["time.dem_step", "velocity_spread"]),
+    "no particles": (setter(("particles",), []), ["particles"]),
+    "unknown section": (setter(("particle",), {}), ["particle", "unknown section"]),
+    "unknown material key": (setter(("materials", "steel", "colour"), "grey"), ["materials.steel.colour"]),
+    "negative density": (setter(("materials", "steel", "density"), -1.0), ["materials.steel.density"]),
+    "density a string": (setter(("materials", "steel", "density"), "heavy"), ["materials.steel.density"]),
+    "radius a boolean": (setter(P0 + ("radius",), True), ["particles[0].radius"]),
+    "radius zero": (setter(P0 + ("radius",), 0.0), ["particles[0].radius"]),
+    "count not integer": (setter(P0 + ("count",), 1.5), ["particles[0].count"]),
+    "restitution above one": (setter(("materials", "steel", "dem", "restitution"), 1.5),
+                              ["materials.steel.dem.restitution"]),
+    "Poisson ratio 0.5": (setter(("materials", "steel", "poisson_ratio"), 0.5), ["materials.steel.poisson_ratio"]),
+    "b2 below b1": (setter(("materials", "steel", "b2"), 1.0), ["materials.steel.b2"]),
+    "unknown material": (setter(P0 + ("material",), "gold"), ["particles[0].material", "gold"]),
+    "region and positions": (setter(P0 + ("region",), [0.0, 0.1, 0.0, 0.01, 0.0, 0.02]), ["particles[0]", "either"]),
+    "positions fewer than count": (setter(P0 + ("count",), 2), ["particles[0].positions"]),
+    "box min above max": (setter(("domain", "box"), [0.1, 0.0, 0.0, 0.01, 0.0, 0.02]), ["domain.box"]),
+    "step beyond end": (setter(("time", "dem_step"), 1.0), ["time.dem_step"]),
+    "unknown contact model": (setter(("effects", "contact_heat"), "D"), ["effects.contact_heat"]),
+    "unknown heat path": (setter(("effects", "heat_path"), "quick"), ["effects.heat_path"]),
+    "feedback without model": (both(setter(("effects", "contact_heat"), "none"),
+                                    setter(("effects", "restitution_feedback"), True)),
+                               ["effects.restitution_feedback"]),
+    "fluid without section": (setter(("effects", "fluid"), True), ["fluid", "missing"]),
+    "fluid cells zero": (fluid(cells=[0, 1, 1]), ["fluid.cells"]),
+    "inlet table decreasing": (fluid(inlet_table=[[0.0, 0.1], [0.0, 0.2]]), ["fluid.inlet_table"]),
+    "inlet table and velocity": (fluid(inlet_table=[[0.0, 0.1]], inlet_velocity=1.0), ["fluid.inlet_table"]),
+    "unknown drag law": (fluid(drag="stokes"), ["fluid.drag"]),
+    "missing time": (remove(("time",)), ["time", "missing"]),
+    "sample_every zero": (setter(("time", "sample_every"), 0), ["time.sample_every"]),
+    "wall temperature negative": (setter(("walls",), [dict(plane="zlo", material="steel", temperature=-1.0)]),
+                                  ["walls[0].temperature"]),
+    "wall plane unknown": (setter(("walls",), [dict(plane="top", material="steel")]), ["walls[0].plane"]),
+}
+
+
+def run_main(args, capsys):
+    code = main([str(a) for a in args])
+    err = capsys.readouterr().err
+    return code, err
+
+
+def assert_one_line(err, words):
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), err
+    assert "Traceback" not in err
+    for w in words:
+        assert w in lines[0], (w, lines[0])
+
+
+@pytest.fixture
+def no_engine(monkeypatch):
+    """Fail at once, rather than run an engine in this process, if a scene got through."""
+    def started(*args, **kwargs):
+        raise AssertionError("an engine was started")
+    monkeypatch.setattr("pyhost.dem.Dem", started)
+    monkeypatch.setattr("pyhost.commands.run.start_fluid", started)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_bad_scene_is_refused_before_any_engine(name, tmp_path, capsys, no_engine):
+    change, words = SCENES[name]
+    scene = copy.deepcopy(BASE)
+    change(scene)
+    case = tmp_path / "case"
+    case.mkdir()
+    (case / "case.toml").write_text(tomli_w.dumps(scene))
+    code, err = run_main(["run", case, "--out", tmp_path / "out"], capsys)
+    assert code == 2, err
+    assert_one_line(err, [str(case / "case.toml"), *words])
+    assert not (tmp_path / "out" / "summary.json").exists() and not (tmp_path / "out" / "dem").exists()
+
+
+def base_case(tmp_path):
+    case = tmp_path / "case"
+    case.mkdir(exist_ok=True)
+    (case / "case.toml").write_text(tomli_w.dumps(BASE))
+    return case
+
+
+def test_base_scene_is_valid():
+    """The catalogue's base passes validation: each entry fails for its own change only."""
+    from pyhost.scene import load_scene
+    import tempfile
+    with tempfile.TemporaryDirectory() as d:
+        assert load_scene(base_case(Path(d)) / "case.toml").time.end == 2e-3
+
+
+def file_fault(kind):
+    def make(tmp_path):
+        case = tmp_path / "case"
+        case.mkdir()
+        if kind == "folder":
+            (case / "case.toml").mkdir()
+        elif kind == "latin-1":
+            (case / "case.toml").write_bytes(tomli_w.dumps(BASE).encode() + b"# caf\xe9\n")
+        elif kind == "toml":
+            (case / "case.toml").write_text("[time\n")
+        return case
+    return make
+
+
+FILES = {
+    "case.toml is a folder": (file_fault("folder"), ["is a folder"]),
+    "non-UTF-8 bytes": (file_fault("latin-1"), ["not UTF-8", "line ", "0xe9"]),
+    "not TOML": (file_fault("toml"), ["not valid TOML"]),
+    "no case.toml": (file_fault("none"), ["no such scene file"]),
+}
+
+
+@pytest.mark.parametrize("name", FILES)
+def test_bad_scene_file(name, tmp_path, capsys):
+    make, words = FILES[name]
+    case = make(tmp_path)
+    code, err = run_main(["run", case, "--out", tmp_path / "out"], capsys)
+    assert code == 2
+    assert_one_line(err, [str(case / "case.toml"), *words])
+
+
+def out_fault(kind):
+    def make(tmp_path):
+        out = tmp_path / "out"
+        if kind == "file":
+            out.write_text("not a folder")
+        elif kind == "under a file":
+            (tmp_path / "f").write_text("")
+            out = tmp_path / "f" / "out"
+        elif kind == "another run":
+            out.mkdir()
+            (out / "summary.json").write_text('{"status": "completed"}')
+        return out
+    return make
+
+
+OUTS = {
+    "--out is a file": (out_fault("file"), ["--out", "is a file"]),
+    "--out under a file": (out_fault("under a file"), ["--out", "cannot write"]),
+    "--out holds another run": (out_fault("another run"), ["--out", "--overwrite"]),
+}
+
+
+@pytest.mark.parametrize("name", OUTS)
+def test_bad_output_folder(name, tmp_path, capsys):
+    make, words = OUTS[name]
+    out = make(tmp_path)
+    code, err = run_main(["run", base_case(tmp_path), "--out", out], capsys)
+    assert code == 2
+    assert_one_line(err, [str(out), *words])
+    if name == "--out holds another run":
+        assert json.loads((out / "summary.json").read_text()) == {"status": "completed"}   # nothing lost
+
+
+def test_full_disk_is_a_message_and_leaves_no_half_file(tmp_path):
+    """A file size limit stands in for a full disk: scene.json cannot be written."""
+    def small_files():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1000, 1000))
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(base_case(tmp_path)), "--out", str(out)],
+                       capture_output=True, text=True, preexec_fn=small_files)
+    assert r.returncode == 2
+    assert_one_line(r.stderr, ["scene.json", "File too large"])
+    assert not (out / "scene.json").exists() and not list(out.glob(".*.tmp"))
+
+
+CLI = {  # id: (arguments, exit code, words)
+    "unknown command": (["fly"], 2, ["invalid choice"]),
+    "run without case": (["run"], 2, ["case"]),
+    "collide v0 1e300": (["collide", "--v0", "1e300"], 2, ["--v0", "overflow"]),
+    "collide v0 1e300 fast": (["collide", "--v0", "1e300", "--method", "fast"], 2, ["--v0", "overflow"]),
+    "collide R 1e100": (["collide", "--R1", "1e100", "--R2", "1e100"], 2, ["R1=1e+100", "double precision"]),
+    "collide E* 1e300": (["collide", "--Estar", "1e300"], 2, ["Estar=1e+300"]),
+    "collide dT 1e308": (["collide", "--dT", "1e308"], 2, ["dT=1e+308"]),
+    "collide v0 negative": (["collide", "--v0", "-1"], 2, ["v0"]),
+    "collide v0 not a number": (["collide", "--v0", "fast"], 2, ["--v0"]),
+    "collide model D": (["collide", "--model", "D"], 2, ["--model"]),
+    "collide R1 zero": (["collide", "--R1", "0"], 2, ["R1"]),
+    "collide Y NaN": (["collide", "--Y", "nan"], 2, ["Y"]),
+    "pictures of no run": (["pictures", "/nonexistent"], 2, ["history.csv"]),
+}
+
+
+@pytest.mark.parametrize("name", CLI)
+def test_bad_command_line(name, capsys):
+    args, code, words = CLI[name]
+    try:
+        got, err = run_main(args, capsys)
+    except SystemExit as exit_:            # argparse's own errors
+        got, err = exit_.code, capsys.readouterr().err
+    assert got == code, err
+    assert "Traceback" not in err and all(w in err for w in words), err
+
+
+def strict_json(text):
+    def no_constant(name):
+        raise AssertionError(f"{name} in JSON output")
+    return json.loads(text, parse_constant=no_constant)
+
+
+@pytest.mark.parametrize("args,flag", [(["--v0", "1e6"], "delta_max_exceeds_radius"),
+                                       (["--v0", "1e6", "--method", "fast"], "delta_max_exceeds_radius"),
+                                       (["--v0", "1e4", "--method", "fit"], "outside_fit_range"),
+                                       (["--v0", "1", "--b1", "1.5", "--b2", "3", "--method", "fit"],
+                                        "outside_fit_range")])
+def test_collision_outside_validity_is_flagged_in_valid_json(args, flag, capsys):
+    code = main(["collide", "--json", *args])
+    out, err = capsys.readouterr()
+    assert code == 0
+    row = strict_json(out)
+    assert flag in row["flags"] and flag in err
+
+
+def test_collision_inside_validity_has_no_flag(capsys):
+    assert main(["collide", "--json", "--v0", "1"]) == 0
+    assert strict_json(capsys.readouterr().out)["flags"] == []
+
+
+def test_corrupt_table_cache_is_rebuilt_with_a_warning(tmp_path, monkeypatch):
+    from plugins.heat import fast
+    monkeypatch.setenv("COLLHEAT_CACHE", str(tmp_path))
+    fast.table.cache_clear()
+    try:
+        good = fast.collide_fast([1.0], model="B")["Q"]
+        fast.table.cache_clear()
+        stored = next(tmp_path.glob("table-B-*.npy"))
+        data = bytearray(stored.read_bytes())
+        data[len(data) // 2] ^= 0xFF
+        stored.write_bytes(bytes(data))
+        with pytest.warns(fast.CacheWarning, match="corrupt"):
+            again = fast.collide_fast([1.0], model="B")["Q"]
+        assert again == good
+        fast.table.cache_clear()
+        import warnings
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", fast.CacheWarning)   # the rebuilt table is sound
+            assert fast.collide_fast([1.0], model="B")["Q"] == good
+    finally:
+        fast.table.cache_clear()
+
+
+def test_fluid_mesh_rebuilt_when_its_inputs_change(tmp_path):
+    from pyhost.fluid_case import box_case
+    walls = {f: "wall" for f in ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")}
+    make = lambda cells: box_case(tmp_path, lo=(0, 0, 0), hi=(1, 1, 1), cells=cells, boundaries=walls, rho=1.0, nu=1e-5)
+    mesh = make((2, 2, 2)) / "constant" / "polyMesh"
+    mesh.mkdir()
+    (mesh / "owner").write_text("built")
+    make((2, 2, 2))
+    assert (mesh / "owner").exists()               # same inputs: the mesh is kept
+    make((2, 2, 3))
+    assert not mesh.exists()                       # other cells: built anew by the next start
+
+
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_debug_shows_the_error_itself(where, tmp_path):
+    """--debug (before or after the command) lets the exception through, for its traceback."""
+    from pyhost.scene import SceneError
+    args = ["run", str(tmp_path / "missing")]
+    with pytest.raises(SceneError, match="no such scene file"):
+        main(["--debug", *args] if where == "before" else [*args, "--debug"])
