@@ -225,7 +225,7 @@ def _missing(columns, require) -> list:
             if not any(set(option.split()) <= have for option in REQUIRED[name])]
 
 
-def _open(path: Path):
+def open_text(path: Path):
     """Text stream of a plain or gzipped file (gzip told by its magic bytes)."""
     with open(path, "rb") as f:
         magic = f.read(2)
@@ -318,7 +318,7 @@ class DumpReader:
         if path.suffix.lower() in VTK_SUFFIXES:
             return _vtk_step(path)
         try:
-            with _open(path) as f:
+            with open_text(path) as f:
                 head = [f.readline() for _ in range(2)]
         except STREAM_ERRORS as exc:
             raise DumpError(path, None, 1, f"unreadable ({type(exc).__name__}: {exc})") from None
@@ -359,7 +359,7 @@ class DumpReader:
 
     def _text(self, path: Path):
         try:
-            stream = _open(path)
+            stream = open_text(path)
         except OSError as exc:
             self._fail(DumpError(path, None, 0, f"cannot open: {exc.strerror}"))
             return

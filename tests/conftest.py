@@ -63,6 +63,7 @@ compute cw all wall/gran/local vel id pos delta
 thermo 1000
 dump d1 all custom 500 post/dump.* id type x y z vx vy vz radius f_Temp[0]
 dump d2 all custom 500 post/all.dump vx vy vz radius id type z x y f_Temp
+dump d3 all custom 20 post/fine.dump id type x y z vx vy vz radius
 dump dv all custom/vtk 500 post/p_*.vtk id type x y z vx vy vz radius
 dump dl all local 20 post/pair.* {pair}
 dump dw all local 20 post/wall.* {wall}
@@ -74,7 +75,7 @@ run 6000
 def pour_dumps(tmp_path_factory):
     """Dumps of a 60-particle pour on Debian's LIGGGHTS (about 1 s): post/dump.* (one step a
     file, f_Temp[0]), post/all.dump (every step in one file, scrambled columns, f_Temp),
-    post/p_*.vtk (custom/vtk), post/pair.* and post/wall.* (contacts every 20 steps)."""
+    post/p_*.vtk (custom/vtk), post/fine.dump (every 20 steps), post/pair.* and post/wall.* (contacts every 20 steps)."""
     import shutil
     import subprocess
 
