@@ -226,7 +226,7 @@ class Post:
             self.particles.add(ids, types, f["radius"], temp)
             steps.append(f.step)
             last = f
-            if not self.contacts and len(f):
+            if not self.contacts:
                 self.position_contacts(f, ids, walls, found, first, steps)
         self.summary["frames"] = len(steps)
         self.summary["particles"] = len(last) if last is not None else 0
@@ -235,6 +235,9 @@ class Post:
         return found
 
     def position_contacts(self, f, ids, walls, found, first, steps) -> None:
+        if not len(f):
+            first.new(np.empty(0, np.int64))
+            return
         if walls and f.box is None:
             raise ValueError(f"{f.file}: a VTK dump has no box, so plane walls cannot be placed: use text dumps")
         x = f.positions()
@@ -280,6 +283,8 @@ class Post:
                 previous = f.step
                 if len(f):
                     self.add_dump_contacts(f, cid, first, found, window)
+                else:
+                    first.new(np.empty(0, np.int64))        # an empty frame ends every contact
         if intervals:
             self.interval = min(intervals)
 
