@@ -64,11 +64,16 @@ def first_appearances(files, key):
 
 
 @pytest.mark.engines
-def test_collision_counts_match_an_independent_count_of_the_contact_dumps(pour_dumps, tmp_path):
+@pytest.mark.parametrize("told", ["script", "options"])
+def test_collision_counts_match_an_independent_count_of_the_contact_dumps(pour_dumps, tmp_path, told):
+    """The computes' keywords and dt from the script, or from options (typed as in the script)."""
     (tmp_path / "scene.toml").write_text(GLASS + STEEL_WALL)
     post_dir = pour_dumps / "post"
+    how = (["--script", pour_dumps / "in.pour"] if told == "script" else
+           ["--dt", "1e-5", "--compute", "cp pair/gran/local delta id vel pos", "--compute",
+            "cw wall/gran/local vel id pos delta"])
     run = post(post_dir / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts", post_dir / "pair.*",
-               post_dir / "wall.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / "out")
+               post_dir / "wall.*", *how, "--out", tmp_path / "out")
     assert run.returncode == 0, run.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     # columns of 'delta id vel pos' in LIGGGHTS' order (ENGINES.md): pair ids 13, 14; wall mesh 13, id 15
@@ -144,6 +149,12 @@ def test_a_failure_keeps_what_came_before_and_says_incomplete(tmp_path):
     [row] = rows(tmp_path / "out")
     assert (row["i"], row["j"], float(row["time"])) == ("1", "2", pytest.approx(1e-5))
     assert 0.2 < float(row["v0"]) < 0.2 * 1.01       # approach 0.2 m/s, slowed a little by that overlap
+    skip = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--out", tmp_path / "skip",
+                "--skip-bad-frames")
+    assert skip.returncode == 0, skip.stderr
+    summary = json.loads((tmp_path / "skip" / "summary.json").read_text())
+    assert summary["complete"] is True and summary["frames"] == 2 and len(rows(tmp_path / "skip")) == 1
+    assert any("skipped" in w and "timestep 20" in w and "line 33" in w for w in summary["warnings"])
 
 
 @pytest.mark.parametrize("change, problem", [
