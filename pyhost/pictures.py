@@ -30,8 +30,14 @@ def plot_history(out: Path) -> Path:
     ax2.set_xlabel("time [ms]")
     ax2.set_ylabel("collisions so far")
     ax2.grid(alpha=0.3)
+    return _save(fig, out / "temperatures.png")
+
+
+def _save(fig, path: Path) -> Path:
+    """Tight layout, 100 dpi, figure closed (pictures are drawn in batches)."""
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
-    path = out / "temperatures.png"
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
@@ -173,8 +179,4 @@ def plot_post(out: Path, last, pair_names, times, pair_heat) -> Path:
     if pair_names:
         ax2.legend()
     ax2.grid(alpha=0.3)
-    fig.tight_layout()
-    path = out / "post.png"
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return _save(fig, out / "post.png")
