@@ -21,8 +21,6 @@ from __future__ import annotations
 import csv
 import gzip
 import json
-import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,7 +32,7 @@ from pyhost.contacts import find_contacts
 from pyhost.dem_input import hertz_collision_time
 from pyhost.dumps import DumpError, DumpReader, expand, open_text
 from pyhost.output import VtkSeries
-from pyhost.scene import Material, SceneError, _build
+from pyhost.scene import Material, SceneError, Wall, _build, read_toml
 
 PLANES = ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")
 MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
@@ -42,20 +40,12 @@ MODELS = ("A", "B", "C")
 
 
 @dataclass(frozen=True)
-class PostWall:
-    material: str
-    fix: str = ""
-    plane: str = ""
-    temperature: float = 0.0        # [K]; 0 adiabatic
-
-
-@dataclass(frozen=True)
 class PostScene:
     path: Path
-    materials: dict                 # name -> Material (real and DEM values)
+    materials: dict                 # name -> Material (real and DEM values, types, temperature)
     types: dict                     # LIGGGHTS atom type -> material index
     temperature: list               # initial temperature per material [K]; 0: from the dumps
-    walls: list                     # PostWall
+    walls: list                     # pyhost.scene.Wall
 
 
 def load_post_scene(path) -> PostScene:
@@ -63,53 +53,32 @@ def load_post_scene(path) -> PostScene:
     (``fix`` or ``plane``, ``material``, ``temperature``) of a scene file; its other sections
     belong to runs and are not read here, so a case.toml serves both."""
     path, file = Path(path), str(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise SceneError(f"{file}: no such scene file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{file}: not valid TOML: {exc}") from None
+    data = read_toml(path)
     if not isinstance(data.get("materials"), dict) or not data["materials"]:
         raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
-    materials, types, temperature = {}, {}, []
-    for k, (name, table) in enumerate(data["materials"].items()):
-        where = f"{file}: materials.{name}"
-        table = dict(table) if isinstance(table, dict) else table
-        listed = table.pop("types", []) if isinstance(table, dict) else []
-        T = table.pop("temperature", 0.0) if isinstance(table, dict) else 0.0
-        materials[name] = _build(Material, table, f"materials.{name}", file)
-        if not isinstance(listed, list):
-            raise SceneError(f"{where}.types: the LIGGGHTS atom types of this material, e.g. [1, 2]; got {listed!r}")
-        for t in listed:
+    materials = {name: _build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
+    types = {}
+    for k, (name, m) in enumerate(materials.items()):
+        for t in m.types:
             if not isinstance(t, int) or isinstance(t, bool) or t < 1:
-                raise SceneError(f"{where}.types: atom types are integers >= 1, got {t!r}")
+                raise SceneError(f"{file}: materials.{name}.types: atom types are integers >= 1, got {t!r}")
             if t in types:
-                raise SceneError(f"{where}.types: type {t} is also in materials.{list(materials)[types[t]]}")
+                raise SceneError(f"{file}: materials.{name}.types: type {t} is also in "
+                                 f"materials.{list(materials)[types[t]]}")
             types[t] = k
-        if not isinstance(T, (int, float)) or isinstance(T, bool) or not T >= 0 or not math.isfinite(T):
-            raise SceneError(f"{where}.temperature: must be a temperature >= 0 [K], got {T!r}")
-        temperature.append(float(T))
-    walls = []
-    for k, w in enumerate(data.get("walls", [])):
-        where = f"{file}: walls[{k}]"
-        if not isinstance(w, dict):
-            raise SceneError(f"{where}: must be a table")
-        unknown = set(w) - {"material", "fix", "plane", "temperature"}
-        if unknown:
-            raise SceneError(f"{where}.{sorted(unknown)[0]}: unknown key; known: material, fix, plane, temperature")
-        wall = PostWall(w.get("material"), w.get("fix", ""), w.get("plane", ""), w.get("temperature", 0.0))
-        if wall.material not in materials:
-            raise SceneError(f"{where}.material: unknown material {wall.material!r}; known: {', '.join(materials)}")
-        if bool(wall.fix) == bool(wall.plane):
-            raise SceneError(f"{where}: give either fix (a LIGGGHTS wall fix id) or plane ({', '.join(PLANES)})")
-        if wall.plane and wall.plane not in PLANES:
-            raise SceneError(f"{where}.plane: must be one of {', '.join(PLANES)}, got {wall.plane!r}")
-        if not isinstance(wall.temperature, (int, float)) or not wall.temperature >= 0:
-            raise SceneError(f"{where}.temperature: must be >= 0 [K] (0 adiabatic), got {wall.temperature!r}")
-        walls.append(wall)
     if not types:
         raise SceneError(f"{file}: materials: no material names its LIGGGHTS atom types (types = [1, 2])")
-    return PostScene(path, materials, types, temperature, walls)
+    if not isinstance(data.get("walls", []), list):
+        raise SceneError(f"{file}: walls: must be [[walls]] tables")
+    walls = [_build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+    for k, wall in enumerate(walls):
+        if wall.material not in materials:
+            raise SceneError(f"{file}: walls[{k}].material: unknown material {wall.material!r}; "
+                             f"known: {', '.join(materials)}")
+        if bool(wall.fix) == bool(wall.plane):
+            raise SceneError(f"{file}: walls[{k}]: give either fix (a LIGGGHTS wall fix id) or plane "
+                             f"({', '.join(PLANES)})")
+    return PostScene(path, materials, types, [m.temperature for m in materials.values()], walls)
 
 
 class Particles:
