@@ -177,3 +177,39 @@ def test_an_atom_type_without_material_is_an_error(tmp_path):
     (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1]\ntemperature = 300"))
     run = post(tmp_path / "d", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--out", tmp_path / "out")
     assert run.returncode == 2 and "atom type 3 is in no material" in run.stderr
+
+
+@pytest.mark.engines
+def test_offline_agrees_with_the_online_run(pour_dumps, tmp_path):
+    """The pour run by the host (``pyhost run``, contacts sampled every 20 steps) and the same
+    script's own dumps (contacts every 20 steps) post-processed: the same collisions at the
+    same times, the same impact speeds to the 6 digits the dumps keep, the same heat."""
+    for name in ("in.pour", "floor.stl"):
+        (tmp_path / name).write_text((pour_dumps / name).read_text())
+    (tmp_path / "post").mkdir()
+    (tmp_path / "case.toml").write_text('[dem]\nscript = "in.pour"\n\n[effects]\ncontact_heat = "A"\n\n'
+                                        + GLASS + STEEL_WALL + "\n[time]\nsample_every = 20\n\n"
+                                        "[output]\npictures = false\n")
+    online = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "online")],
+                            capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert online.returncode == 0, online.stdout[-2000:] + online.stderr[-2000:]
+    offline = post(tmp_path / "post" / "dump.*", "--scene", tmp_path / "case.toml", "--contacts",
+                   tmp_path / "post" / "pair.*", tmp_path / "post" / "wall.*", "--script", tmp_path / "in.pour",
+                   "--model", "A", "--out", tmp_path / "offline")
+    assert offline.returncode == 0, offline.stderr
+    run = json.loads((tmp_path / "online" / "summary.json").read_text())
+    done = json.loads((tmp_path / "offline" / "summary.json").read_text())
+    assert done["collisions"] == {"particle_particle": run["particle_particle"], "particle_wall": run["particle_wall"]}
+    with open(tmp_path / "online" / "collisions.csv") as f:
+        on = {(round(float(r["time"]), 9), frozenset((r["i"], r["j"], r["wall"]))): r for r in csv.DictReader(f)}
+    off = {(round(float(r["time"]), 9), frozenset((r["i"], r["j"], r["wall"]))): r for r in rows(tmp_path / "offline")}
+    assert set(on) == set(off) and len(on) > 200
+    v_on, v_off = (np.array([float(d[k]["v0"]) for k in sorted(on, key=str)]) for d in (on, off))
+    Q_on = np.array([float(on[k]["Q"]) for k in sorted(on, key=str)])
+    Q_off = np.array([float(off[k]["Q_A"]) for k in sorted(on, key=str)])
+    wall = np.array([on[k]["wall"] != "0" for k in sorted(on, key=str)])
+    print(f"v0: max relative difference {np.max(np.abs(v_off / v_on - 1)):.2g}; wall heat "
+          f"{-Q_off[wall].sum():.6g} J offline, {-Q_on[wall].sum():.6g} J online")
+    assert np.allclose(v_off, v_on, rtol=5e-4)             # dumps keep 6 digits of x, v and the overlap
+    assert -Q_off[wall].sum() == pytest.approx(run["heat_from_walls"], rel=1e-4)
+    assert np.abs(Q_off[~wall]).sum() == pytest.approx(np.abs(Q_on[~wall]).sum(), rel=1e-3)
