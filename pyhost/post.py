@@ -30,7 +30,7 @@ from pyhost.collisions import WALL_BASE, DemHertz, contact_keys, exchange_heat
 from pyhost.contact_heat import evaluate
 from pyhost.contacts import find_contacts
 from pyhost.dem_input import hertz_collision_time
-from pyhost.dumps import DumpError, DumpReader, expand, open_text
+from pyhost.dumps import STREAM_ERRORS, DumpError, DumpReader, expand, open_text
 from pyhost.output import VtkSeries
 from pyhost.scene import Material, SceneError, Wall, _build, read_toml
 
@@ -224,8 +224,11 @@ class Post:
         """Contact dump files grouped by the compute their columns come from (one stream each)."""
         streams = {}
         for p in expand(self.contacts):
-            with open_text(p) as f:
-                head = [f.readline() for _ in range(9)]
+            try:
+                with open_text(p) as f:
+                    head = [f.readline() for _ in range(9)]
+            except STREAM_ERRORS as exc:
+                raise DumpError(p, None, 1, f"unreadable ({type(exc).__name__}: {exc})") from None
             cid = head[8].split()[2].split("[")[0][2:] if head[8].startswith("ITEM: ENTRIES c_") else None
             if cid is None:
                 raise DumpError(p, None, 9, f"not a dump local of a compute: {head[8].strip()[:60]!r}")
@@ -386,6 +389,7 @@ class Post:
 
     def write_summary(self) -> None:
         self.summary["complete"] = self.error is None and self.done
+        self.summary["warnings"] = list(dict.fromkeys(self.warnings))    # the particle dumps are read twice
         if self.error is not None:
             self.summary["error"] = str(self.error)
         (self.out / "summary.json").write_text(json.dumps(self.summary, indent=1, default=float))
