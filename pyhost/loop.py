@@ -30,6 +30,7 @@ import numpy as np
 from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat
 from pyhost.contact_heat import evaluate, restitution_impulse
 from pyhost.dem import Dem
+from pyhost.liggghts import LiggghtsError
 from pyhost.output import CsvLog, Progress, VtkSeries
 from pyhost.script import ScriptError, parse_run
 
@@ -87,7 +88,7 @@ class Coupling:
         self.steps = 0
         self.totals = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0,
                            heat_from_walls=0.0, capped=0, clipped=0, heat_gran_undone=0.0,
-                           inserted=0, departed=0, energy_in=0.0, energy_out=0.0)
+                           inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0)
         self.CT_by_id = np.zeros(0)      # m c T of each id at its last sample [J] (energy balance)
         self.seen = np.zeros(0, bool)
         self.warned = set()
@@ -116,6 +117,8 @@ class Coupling:
 
     def advance(self, n: int) -> None:
         """n coupled DEM steps: the loop of the module doc."""
+        if self.heat:
+            self.resync()
         while n > 0:
             step = self.dem.step - self.t0_step
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
@@ -134,6 +137,21 @@ class Coupling:
             if due["frame"]:
                 self.write_frame()
             self.progress.update(self.t, f", {self.totals['collisions']} collisions")
+        if self.heat:
+            self.track_particles(self.dem.atoms(True))
+
+    def resync(self) -> None:
+        """Before each run: heat content that the script's own commands changed since the last
+        run (e.g. ``set ... property/atom Temp``) enters the balance as set by the script."""
+        atoms = self.dem.atoms(True)
+        known = np.zeros(len(atoms.id), bool)
+        inside = atoms.id < len(self.seen)
+        known[inside] = self.seen[atoms.id[inside]]
+        if known.any():
+            C = atoms.mass[known] * self.capacity[self.materials_of(atoms.type[known])]
+            self.totals["energy_set_by_script"] += float(np.sum(C * atoms.T[known])
+                                                         - self.CT_by_id[atoms.id[known]].sum())
+        self.track_particles(atoms)
 
     # -- particles ----------------------------------------------------------------------
     def materials_of(self, types) -> np.ndarray:
@@ -325,10 +343,11 @@ class Coupling:
         less the fluid's own hydrostatic head between them; the bed height [m], twice the mean
         particle centre height above the box floor (exact for a uniform bed)."""
         z = self.fluid.cell_centres[:, 2]
-        head = self.scene.fluid.density * self.scene.domain.gravity[2] * (z.max() - z.min())
+        head = self.fluid.rho * self.fluid.gravity()[2] * (z.max() - z.min())
         floor = self.dem.box()[0][2]
-        return (float(self.scene.fluid.inlet_at(self.t)), layer_pressure_drop(self.fluid) + head,
-                2.0 * float(np.mean(atoms.x[:, 2] - floor)))
+        inlet = math.nan if self.scene.fluid.case else float(self.scene.fluid.inlet_at(self.t))
+        return (inlet, layer_pressure_drop(self.fluid) + head,
+                2.0 * float(np.mean(atoms.x[:, 2] - floor)) if len(atoms.x) else math.nan)
 
     # -- output -------------------------------------------------------------------------
     def write_frame(self) -> None:
@@ -362,8 +381,8 @@ class Coupling:
             CT = float(np.sum(self.C * atoms.T))
             t = self.totals
             summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=(    # relative to all
-                CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"])     # that came in
-                / max(self.CT0 + t["energy_in"], 1e-300))
+                CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]      # that came in
+                - t["energy_set_by_script"]) / max(self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"]), 1e-300))
         (self.out / "summary.json").write_text(json.dumps(summary, indent=1))
         self.collisions.close()
         self.history.close()
@@ -385,8 +404,11 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 continue
             run = parse_run(cmd)
             if coupling is None:
-                added = dem.prepare(heat=effects["collision_heat"], contacts=effects["contact_extraction"],
-                                    fluid_force=fluid is not None)
+                try:
+                    added = dem.prepare(heat=effects["collision_heat"], contacts=effects["contact_extraction"],
+                                        fluid_force=fluid is not None)
+                except LiggghtsError as exc:
+                    raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
                 log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, **particles)

@@ -164,6 +164,11 @@ class FluidSolver:
     def __exit__(self, *exc) -> None:
         self.stop()
 
+    def gravity(self) -> np.ndarray:
+        """The case's gravity [m/s^2] (constant/g), zero if it has none."""
+        g = self.case / "constant" / "g"
+        return np.asarray(FoamFile(g)["value"], float) if g.is_file() else np.zeros(3)
+
     # -- coupling ---------------------------------------------------------------------
     def particle_forces(self, x: np.ndarray, v: np.ndarray, d: np.ndarray) -> np.ndarray:
         """Fluid force on each particle (N, shape (n, 3)) from the current fluid: drag

@@ -142,6 +142,10 @@ class Domain:
 
 @dataclass(frozen=True)
 class Fluid:
+    case: str = spec(default="", doc="the user's OpenFOAM case folder, relative to the case folder (any mesh, "
+                                     "the user's boundary conditions; solved by collheatFoam). Its "
+                                     "transportProperties give rho and nu, its constant/g the gravity: the "
+                                     "keys density, viscosity, inlet_*, plenum, cells and sides are then unused")
     density: float = spec(">0", 1.2, "[kg/m^3]")
     viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
     inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the inlet (fluid z lo) [m/s]")
@@ -340,9 +344,11 @@ def load_scene(path) -> Scene:
         raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model in effects.contact_heat")
     if effects.fluid and fluid is None:
         raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
-    if effects.fluid and scripted:
-        raise SceneError(f"{file}: effects.fluid: not yet available with dem.script (only the generated box "
-                         "world couples a fluid so far)")
+    if fluid is not None and fluid.case:
+        _user_fluid_case(fluid, path, file)
+    elif effects.fluid and scripted:
+        raise SceneError(f"{file}: fluid.case: a script scene needs its OpenFOAM case (the host generates "
+                         "a fluid only for the box world)")
     if fluid is not None and (len(fluid.cells) != 3 or not all(isinstance(n, int) and n > 0 for n in fluid.cells)):
         raise SceneError(f"{file}: fluid.cells: must be 3 positive integers, got {fluid.cells!r}")
     if fluid is not None and fluid.inlet_table:
@@ -359,6 +365,27 @@ def _script_keys(dem, path, file):
         for name, value in getattr(dem, where).items():
             if isinstance(value, bool) or not isinstance(value, (str, int, float)) or not str(value).strip():
                 raise SceneError(f"{file}: dem.{where}.{name}: must be a number or a word, got {value!r}")
+
+
+FLUID_CASE_FILES = ("system/controlDict", "system/fvSchemes", "system/fvSolution", "0/U", "0/p",
+                    "constant/transportProperties")
+
+
+def _user_fluid_case(fluid, path, file):
+    """A user's OpenFOAM case: the files collheatFoam reads, a mesh or a blockMeshDict, and no
+    scene key that the case itself decides."""
+    folder = path.resolve().parent / fluid.case
+    if not folder.is_dir():
+        raise SceneError(f"{file}: fluid.case: no such folder {str(folder)!r}")
+    missing = [f for f in FLUID_CASE_FILES if not (folder / f).is_file()]
+    if not (folder / "constant" / "polyMesh" / "owner").is_file() and not (folder / "system" / "blockMeshDict").is_file():
+        missing.append("constant/polyMesh or system/blockMeshDict")
+    if missing:
+        raise SceneError(f"{file}: fluid.case: {folder} lacks what collheatFoam needs: {', '.join(missing)}")
+    default = Fluid()
+    for key in ("density", "viscosity", "inlet_velocity", "inlet_table", "plenum", "cells", "sides"):
+        if getattr(fluid, key) != getattr(default, key):
+            raise SceneError(f"{file}: fluid.{key}: comes from the OpenFOAM case {fluid.case!r}, not from the scene")
 
 
 def _types(materials, walls, file):

@@ -5,6 +5,7 @@ import argparse
 import dataclasses
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -34,7 +35,13 @@ def start_fluid(scene, folder: Path):
     from pyhost.fluid_case import box_case
     from pyhost.openfoam import FluidSolver
 
-    f, box = scene.fluid, scene.domain.box
+    f = scene.fluid
+    if f.case:                          # the user's own case, copied: the host never writes into it
+        shutil.rmtree(folder, ignore_errors=True)
+        shutil.copytree(scene.folder / f.case, folder, symlinks=True,
+                        ignore=shutil.ignore_patterns("processor*", ".link", "log.*", "[1-9]*", "0.[0-9]*"))
+        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min).start()
+    box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
              else ("inlet", (0.0, 0.0, f.inlet_velocity)))
