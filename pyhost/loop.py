@@ -42,12 +42,14 @@ FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
 
 @dataclass(frozen=True)
 class HostWall:
-    """A LIGGGHTS wall as the host sees it: its fix id, its real material (index into the
+    """A LIGGGHTS wall as the host sees it: its fix id (and the index of the mesh within a
+    mesh wall fix: each mesh is a wall of its own), its real material (index into the
     scene's materials) and its fixed temperature [K] (NaN: adiabatic)."""
 
     fix: str
     material: int
     temperature: float
+    mesh: int = 0
 
 
 def layer_pressure_drop(fluid) -> float:
@@ -81,7 +83,7 @@ class Coupling:
         self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
         self.before = None
         self.walls = walls
-        self.wall_index = {w.fix: k for k, w in enumerate(walls)}
+        self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
         self.T_wall = np.array([w.temperature if self.effects["wall_heat"] else np.nan for w in walls])
         self.wall_material = np.array([w.material for w in walls], int)
         self.capacity = np.array([m.heat_capacity for m in self.materials])
@@ -254,7 +256,7 @@ class Coupling:
         mat_i = self.materials_of(atoms.type[i])
         wall_mat = np.where(self.wall_material[w] >= 0, self.wall_material[w], mat_i) if len(self.walls) else mat_i
         mat = np.where(wall, wall_mat, self.materials_of(atoms.type[jj]))
-        wall_type = np.array([self.dem.info.wall_type(wl.fix) or 1 for wl in self.walls] or [1])
+        wall_type = np.array([self.dem.info.wall_type(wl.fix, wl.mesh) or 1 for wl in self.walls] or [1])
         typ = np.where(wall, wall_type[w], atoms.type[jj])
         return (wall, jl, mat, typ, np.where(wall, np.inf, atoms.radius[jj]),
                 np.where(wall, np.inf, atoms.mass[jj]))

@@ -283,17 +283,23 @@ def _inlet_table(fluid, file):
 SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output", "dem")
 
 
+def read_toml(path) -> dict:
+    """The tables of a scene file; SceneError if it is missing, not text or not TOML."""
+    from pyhost.validate import read_text
+    try:
+        return tomllib.loads(read_text(Path(path)))
+    except FileNotFoundError:
+        raise SceneError(f"{path}: no such scene file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+
+
 def load_scene(path) -> Scene:
     """Read and validate a scene file; raises SceneError naming the file and the key."""
-    from pyhost.validate import check_raw, check_scene, read_text
+    from pyhost.validate import check_raw, check_scene
     path = Path(path)
     file = str(path)
-    try:
-        data = tomllib.loads(read_text(path))
-    except FileNotFoundError:
-        raise SceneError(f"{file}: no such scene file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{file}: not valid TOML: {exc}") from None
+    data = read_toml(path)
     for key in data:
         if key not in SECTIONS:
             raise SceneError(f"{file}: {key}: unknown section; known: {', '.join(SECTIONS)}")
