@@ -57,6 +57,18 @@ class ContactTracker:
         return opened, closed
 
 
+def temperature_difference(T, i, j, T_wall=None):
+    """T_i - T_j [K] of each collision (j >= WALL_BASE: the wall's temperature; 0 for an
+    adiabatic wall, None or NaN in T_wall), with the temperatures as they are now."""
+    i, j = np.asarray(i), np.asarray(j)
+    wall = j >= WALL_BASE
+    T_j = T[np.where(wall, i, j)]
+    if wall.any():
+        tw = np.full(len(j), np.nan) if T_wall is None else np.asarray(T_wall, float)[np.where(wall, j - WALL_BASE, 0)]
+        T_j = np.where(wall, np.where(np.isnan(tw), T[i], tw), T_j)
+    return T[i] - T_j
+
+
 def exchange_heat(T, C, i, j, G, T_wall=None):
     """Move heat between bodies, one collision after the other, with the temperatures of that
     moment: q = G (T_i - T_j) [J] from i to j, G [J/K] the collision's conductance-time

@@ -18,8 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat
-from pyhost.contact_heat import evaluate, restitution_impulse
+from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
+                               temperature_difference)
+from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
 from pyhost.contacts import ContactFinder
 from pyhost.dem_input import Particles, material_index
 from pyhost.output import CsvLog, Progress, VtkSeries
@@ -59,7 +60,8 @@ class Coupling:
         self.totals = dict(collisions=0, wall_collisions=0, heat_moved=0.0, heat_from_walls=0.0,
                            capped=0, clipped=0, enduring_heat=0.0)
         self.CT0 = float(np.sum(self.C * self.T))
-        self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS)
+        self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS
+                                 + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:]))
         self.groups = [np.flatnonzero(particles.group == k) for k in range(len(scene.particles))]
         self.history = CsvLog(self.out / "history.csv", ("time", "T_mean", "T_min", "T_max")
                               + tuple(f"T_group{k}" for k in range(len(self.groups)))
@@ -146,22 +148,35 @@ class Coupling:
             s = (mi == a) & (mj == b)
             v0[s] = law.impact_speed(c.delta[rows][s], c.approach[rows][s], R_eff[s], m_eff[s],
                                      window=self.dt_sample)
-        model = self.scene.effects.contact_heat
+        models = self.scene.effects.heat_models
+        model = models[0] if models else "none"
         moved = e = t_coll = np.zeros(len(rows))
-        if model != "none":
-            G, e, t_coll = evaluate(model, self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0,
-                                    np.ones(len(rows)))                        # Q per kelvin [J/K]
+        side = {}
+        if models:
+            args = (self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0, np.ones(len(rows)))
+            G, e, t_coll = evaluate(model, *args)                               # Q per kelvin [J/K]
+            if len(models) > 1:         # side columns: the same collisions at the same dT, nothing moved
+                dT = temperature_difference(self.T, i, j, self.T_wall)
+                side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}
             moved, capped, from_walls = exchange_heat(self.T, self.C, i, j, G, self.T_wall)
             self.totals["capped"] += capped
             self.totals["heat_from_walls"] += from_walls
             self.totals["heat_moved"] += float(np.abs(moved[~wall]).sum())
+            by_model = self.heat_by_model()
+            for m, q in zip(models, [moved] + list(side.values())):
+                by_model[m] += float(np.abs(q[~wall]).sum())
         for k, key in enumerate(keys[rows]):
             self.open[int(key)] = (self.t, t_coll[k], e[k], v0[k])
         self.totals["collisions"] += len(rows)
         self.totals["wall_collisions"] += int(wall.sum())
         self.collisions.write_columns(time=np.full(len(rows), self.t), i=i + 1, j=np.where(wall, 0, j + 1),
                                       wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
-                                      t_coll=t_coll, model=np.full(len(rows), model))
+                                      t_coll=t_coll, model=np.full(len(rows), model), **side)
+
+    def heat_by_model(self) -> dict:
+        """Heat between particles [J], sum of |Q| over collisions, of each heat model: the one
+        that moved it and the side models on the same collisions."""
+        return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
 
     def end_collisions(self, closed, x, v) -> None:
         info = [self.open.pop(int(k)) for k in closed]
@@ -235,6 +250,7 @@ class Coupling:
     def finish(self, status: str = "completed") -> dict:
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
         CT = float(np.sum(self.C * self.T))
+        self.heat_by_model()
         summary = dict(self.totals, status=status, time=self.t, steps=self.step, sum_mcT_start=self.CT0,
                        sum_mcT_end=CT,
                        energy_balance_error=(CT - self.CT0 - self.totals["heat_from_walls"]) / self.CT0)

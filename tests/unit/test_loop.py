@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from plugins.heat import Pair, collide
+from plugins.heat.comparison import COMPARISON
 from pyhost.collisions import DemHertz
-from pyhost.contact_heat import pair_properties
+from pyhost.contact_heat import dem_pair, pair_properties
 from pyhost.contacts import find_contacts
 from pyhost.dem_input import place_particles
 from pyhost.loop import Coupling
@@ -150,3 +151,30 @@ def test_resting_contact_conducts_only_when_enduring_is_on(tmp_path, enduring):
     else:
         assert summary["enduring_heat"] == 0
         assert summary["heat_from_walls"] == pytest.approx(collision_heat, rel=1e-12)
+
+
+def test_side_models_are_columns_and_move_nothing(tmp_path):
+    """contact_heat = [A, hertz, softened]: A moves the heat exactly as alone; the side
+    columns are the plugin's heat of each model on the same collision at the same dT."""
+    (tmp_path / "alone").mkdir()
+    _, _, _, alone = run(tmp_path / "alone")
+    text = SCENE.format(model="A", feedback="false").replace('contact_heat = "A"',
+                                                             'contact_heat = ["A", "hertz", "softened"]')
+    (tmp_path / "case.toml").write_text(text)
+    scene = load_scene(tmp_path / "case.toml")
+    p = place_particles(scene)
+    p.velocity[0, 0], p.velocity[1, 0] = 0.2, -0.2
+    p.temperature[0] = 400.0
+    summary = Coupling(scene, NumpyDem(scene, p), p, tmp_path / "out", progress_every=1e9).run()
+    row, = csv.DictReader(open(tmp_path / "out" / "collisions.csv"))
+    row_alone, = csv.DictReader(open(tmp_path / "alone" / "out" / "collisions.csv"))
+    assert row["Q"] == row_alone["Q"] and row["e"] == row_alone["e"]
+    assert summary["heat_moved"] == alone["heat_moved"]
+    steel = scene.materials["steel"]
+    pair = Pair(R1=2e-3, R2=2e-3, dT=100.0, **pair_properties(steel, steel))
+    v0 = float(row["v0"])
+    assert float(row["Q_hertz"]) == pytest.approx(float(COMPARISON["hertz"].heat(v0, pair)["Q"]), rel=1e-12)
+    assert float(row["Q_softened"]) == pytest.approx(
+        float(COMPARISON["softened"].heat(v0, pair, dem_pair(steel, steel))["Q"]), rel=1e-12)
+    assert summary["heat_by_model"] == pytest.approx(
+        {"A": float(row["Q"]), "hertz": float(row["Q_hertz"]), "softened": float(row["Q_softened"])}, rel=1e-12)
