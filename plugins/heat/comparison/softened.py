@@ -23,8 +23,9 @@ against t/t_s depends on the restitution only. So one trajectory per restitution
 integrated (DOP853, rtol 1e-12) and every collision's
     Q = dT int h(delta(t)) dt
 is a Gauss-Legendre sum over fixed nodes of that trajectory (N_NODES nodes in theta, with
-t = t_c (1 - cos theta)/2, which removes the square-root ends). Relative accuracy about
-1e-8 against a direct time integration (tests/unit/test_comparison.py).
+t = t_c (1 - cos theta)/2, which removes the square-root ends). 32 nodes agree with 128 to 2e-10 for
+restitutions 0.3-1, and the model agrees with a direct time integration to 1e-6, that
+integration's own tolerance (tests/unit/test_comparison.py).
 
 The temperatures are taken as constant over the collision (dT of the pair), as for models
 A, B, C; heat/gran itself conducts with the temperatures of each step. t_coll is the DEM
@@ -42,7 +43,7 @@ from plugins.dem.hertz import DemHertz
 from plugins.heat import exact
 from plugins.heat.comparison import ComparisonModel
 
-N_NODES = 64
+N_NODES = 32
 CHUNK = 8192
 
 
