@@ -11,7 +11,7 @@ import importlib
 import re
 import sys
 
-COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench")
+COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench", "compare")
 
 
 class UserError(Exception):

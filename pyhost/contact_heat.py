@@ -85,3 +85,31 @@ def restitution_impulse(v_i, v_j, m_i, m_j, normal, e_target, v0):
     share_i = np.where(wall, 1.0, m_j / np.where(wall, 1.0, m_i + m_j))
     share_j = np.where(wall, 0.0, m_i / np.where(wall, 1.0, m_i + m_j))
     return (share_i * change)[:, None] * normal, -(share_j * change)[:, None] * normal, clipped
+
+
+def heat_by_model_offline(scene, collisions, models) -> dict:
+    """{model: heat between particles [J], sum of |Q|} of each model on the collisions of a
+    finished run (``collisions``: the columns of its collisions.csv as arrays: i, j, wall
+    (1-based, 0 for none), v0, Q, model). Each collision's dT is the one the run used,
+    Q / (Q per kelvin of the run's own model), so a model's column is what a side column
+    would have held (collisions with an adiabatic wall or capped ones carry no dT back)."""
+    from pyhost.dem_input import material_index, place_particles
+
+    p = place_particles(scene)
+    materials = list(scene.materials.values())
+    wall_mat = np.array([material_index(scene)[w.material] for w in scene.walls] or [0], int)
+    i = np.asarray(collisions["i"], int) - 1
+    w = np.asarray(collisions["wall"], int)
+    wall = w > 0
+    j = np.where(wall, 0, np.asarray(collisions["j"], int) - 1)
+    mi, R_i = p.material[i], p.radius[i]
+    mj = np.where(wall, wall_mat[np.maximum(w - 1, 0)], p.material[j])
+    R_j = np.where(wall, np.inf, p.radius[j])
+    v0, ones = np.asarray(collisions["v0"], float), np.ones(len(i))
+    main = set(np.asarray(collisions["model"]).tolist())
+    if len(main) != 1:
+        raise ValueError(f"collisions.csv holds {len(main)} heat models ({sorted(main)}); expected one")
+    G_main = evaluate(main.pop(), "fast", materials, mi, mj, R_i, R_j, v0, ones)[0]
+    dT = np.asarray(collisions["Q"], float) / G_main
+    return {m: float(np.abs(evaluate(m, "fast", materials, mi, mj, R_i, R_j, v0, ones)[0] * dT)[~wall].sum())
+            for m in models}
