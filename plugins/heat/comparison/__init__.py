@@ -13,10 +13,10 @@ models with ``needs_dem`` use.
 """
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from dataclasses import dataclass
 from typing import Callable
+
+from plugins.heat.registry import collect, lookup
 
 
 @dataclass(frozen=True)
@@ -42,15 +42,9 @@ class ComparisonModel:
     heat: Callable          # heat(v0, pair, dem) -> dict(Q=..., t_coll=..., e=...)
 
 
-COMPARISON: dict[str, ComparisonModel] = {
-    info.name: importlib.import_module(f"{__name__}.{info.name}").MODEL
-    for info in pkgutil.iter_modules(__path__)
-}
+COMPARISON: dict[str, ComparisonModel] = collect(__name__, __path__)
 
 
 def get_comparison(name: str) -> ComparisonModel:
     """The comparison model ``name``; an unknown name raises ValueError with the choices."""
-    try:
-        return COMPARISON[name]
-    except KeyError:
-        raise ValueError(f"unknown comparison model {name!r}; choices: {', '.join(sorted(COMPARISON))}") from None
+    return lookup(COMPARISON, name, "comparison model")
