@@ -92,7 +92,8 @@ def heat_by_model_offline(scene, collisions, models) -> dict:
     finished run (``collisions``: the columns of its collisions.csv as arrays: i, j, wall
     (1-based, 0 for none), v0, Q, model). Each collision's dT is the one the run used,
     Q / (Q per kelvin of the run's own model), so a model's column is what a side column
-    would have held (collisions with an adiabatic wall or capped ones carry no dT back)."""
+    would have held (collisions with an adiabatic wall or capped ones carry no dT back).
+    Box scenes only: particle ids are the order of ``place_particles``."""
     from pyhost.dem_input import material_index, place_particles
 
     p = place_particles(scene)

@@ -1,68 +1,262 @@
-"""The DEM of a scene for the coupling loop, on the LIGGGHTS bridge (``pyhost.liggghts``).
+"""The DEM of a scene on the LIGGGHTS bridge (``pyhost.liggghts``): a LIGGGHTS script run
+command by command, either the user's own (``[dem] script``) or the box world the host
+generates from the scene (``pyhost.dem_input``). Both go through the same class.
 
-Implements what ``pyhost.loop.Coupling`` needs: ``run(steps)``, ``state()`` (positions and
-velocities in particle order), ``add_velocity`` and, when the scene has a fluid,
-``set_force`` (the fluid's force on each particle, held until the next call). The input is
-generated from the validated scene (``pyhost.dem_input``); the bridge tries it in a forked
-copy first, so a LIGGGHTS error arrives as ``LiggghtsError`` with LIGGGHTS' own message.
+What the coupling loop gets from it, each in LIGGGHTS' local order and valid until the next
+``run``: ``atoms()`` (ids, positions, velocities, radii, masses, types and the writable
+``Temp`` of every particle) and ``contacts()`` (every particle-particle and particle-wall
+contact, from LIGGGHTS' own ``compute pair/gran/local`` and ``wall/gran/local``, and from the
+geometry of primitive walls, which LIGGGHTS does not list). Temperatures live in LIGGGHTS'
+per-atom ``Temp`` (the property ``fix heat/gran`` uses), so a script's dumps, restarts and
+fixes see them. What the host adds to a script it prints once, before the first run.
 """
 from __future__ import annotations
 
+import ctypes
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from pyhost.dem_input import Particles, input_lines, write_data
-from pyhost.liggghts import Liggghts
+from pyhost.collisions import WALL_BASE
+from pyhost.liggghts import Liggghts, LiggghtsError
+from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 
-FLUID_FIX = "fluid"
+FLUID_FIX = "collheat_fluid"
+PAIR_COMPUTE, WALL_COMPUTE = "collheat_pairs", "collheat_walls"
+NEEDED = ("pos", "vel", "id")
 
 
-class SceneDem:
-    """LIGGGHTS running a scene's particles (ids 1..N in ``particles`` order)."""
+@dataclass(frozen=True)
+class Atoms:
+    """The particles now, local order (SI): ids, x (n, 3) [m], v (n, 3) [m/s], radius [m],
+    mass [kg], type, T (writable view of LIGGGHTS' Temp [K], or None)."""
 
-    def __init__(self, scene, particles: Particles, workdir: Path, fluid_force: bool = False):
-        workdir = Path(workdir).resolve()
-        workdir.mkdir(parents=True, exist_ok=True)
-        data = write_data(workdir / "particles.data", scene, particles)
-        script = workdir / "in.dem"
-        lines = ["atom_modify sort 0 0"] + input_lines(scene, data)
+    id: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    radius: np.ndarray
+    mass: np.ndarray
+    type: np.ndarray
+    T: np.ndarray | None
+
+    def index(self, ids) -> np.ndarray:
+        """Local index of each atom id (-1 for ids not here)."""
+        ids = np.asarray(ids, np.int64)
+        lookup = np.full(int(max(self.id.max(initial=0), ids.max(initial=0))) + 1, -1, np.int64)
+        lookup[self.id] = np.arange(len(self.id))
+        return lookup[ids]
+
+
+@dataclass(frozen=True)
+class Contacts:
+    """Contacts now, one row each: ``i`` atom id; ``j`` atom id, or WALL_BASE + host wall index;
+    overlap ``delta`` [m]; unit ``normal`` from j to i; ``approach`` = -(v_i - v_j).n [m/s]
+    (> 0 while closing in); ``heat_flux`` [W] into i by the script's fix heat/gran (0 without)."""
+
+    i: np.ndarray
+    j: np.ndarray
+    delta: np.ndarray
+    normal: np.ndarray
+    approach: np.ndarray
+    heat_flux: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.i)
+
+
+def _concat(parts: list[Contacts]) -> Contacts:
+    if not parts:
+        z = np.zeros(0)
+        return Contacts(np.zeros(0, np.int64), np.zeros(0, np.int64), z, np.zeros((0, 3)), z, z)
+    return Contacts(*(np.concatenate([getattr(p, f) for p in parts]) for f in Contacts.__dataclass_fields__))
+
+
+class Dem:
+    """LIGGGHTS running a scene's script. ``walls``: the host's walls in order, each
+    (fix id, material name or None for adiabatic LIGGGHTS walls the scene does not name)."""
+
+    def __init__(self, workdir: Path, *, variables: dict | None = None, log=print):
+        self.lmp = Liggghts(Path(workdir).resolve(), variables=variables)
+        self.info = ScriptInfo()
+        self.log = log
+        self.prepared = False
+        self.fluid_force = False
+        self.pair_cols = self.wall_cols = None
+        self._last_x = None
+
+    # -- the script -----------------------------------------------------------------
+    def command(self, cmd: Command) -> None:
+        """Run one script command; a refusal names the script's file and line."""
+        try:
+            self.lmp.command(cmd.text)
+        except LiggghtsError as exc:
+            raise LiggghtsError(f"{cmd.where()}: {exc}") from None
+        self.info.learn(cmd)
+
+    def steps(self, steps: str, upto: bool) -> int:
+        """The number of steps of a ``run`` (a number or a $variable, evaluated by LIGGGHTS)."""
+        try:
+            n = int(steps)
+        except ValueError:
+            self.lmp.command(f"variable collheat_steps equal {steps}")
+            n = int(round(self.lmp.variable("collheat_steps")))
+        return n - self.lmp.step if upto else n
+
+    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False) -> list[str]:
+        """What the host adds before the first run: the Temp property (if no fix heat/gran or
+        property/atom Temp made it), the contact computes the script lacks, and the fluid force.
+        ``contacts``: whether the loop samples contacts (default: with heat). Returns the
+        added commands (printed once)."""
+        contacts = heat if contacts is None else contacts
+        added = []
+        if heat and not self.info.temp_fix and not self.info.heat_gran:
+            added.append("fix Temp all property/atom Temp scalar yes yes no 0.0")
+        if contacts and self.info.pair_compute is None:
+            keys = "pos vel id delta" + (" heatFlux" if self.info.heat_gran else "")
+            added.append(f"compute {PAIR_COMPUTE} all pair/gran/local {keys}")
+        if contacts and self.info.wall_compute is None and any(w.meshes for w in self.info.walls.values()):
+            added.append(f"compute {WALL_COMPUTE} all wall/gran/local pos vel id delta")
         if fluid_force:
-            lines.append(f"fix {FLUID_FIX} all external pf/array 1")
-        script.write_text("\n".join(lines) + "\n")
-        self.n = len(particles.radius)
-        self.fluid_force = fluid_force
-        self.lmp = Liggghts(workdir)
-        self.lmp.file(script)
+            added.append(f"fix {FLUID_FIX} all external pf/array 1")
+        for line in added:
+            self.command(Command(line, "(host)", 0))
+        for which in ("pair_compute", "wall_compute"):
+            found = getattr(self.info, which)
+            if found and found[0] not in (PAIR_COMPUTE, WALL_COMPUTE):
+                missing = [k for k in NEEDED if k not in (found[1] or NEEDED)]
+                if missing:
+                    raise ScriptError(f"the script's compute {found[0]} lacks the keyword(s) {' '.join(missing)} "
+                                      "the host needs: add them (LIGGGHTS allows one such compute)")
         self.lmp.run(0)
-        if fluid_force:     # run 0 added the fix's array while it was uninitialised memory, and the
-            self.lmp.external_force(FLUID_FIX)[:] = 0.0   # first step would integrate that force:
-            self.lmp.command("run 0")                     # zero it and set up again
-        self._views()
-
-    def _views(self) -> None:
-        if self.lmp.nlocal != self.n:
-            raise RuntimeError(f"LIGGGHTS holds {self.lmp.nlocal} particles, the scene {self.n}: "
-                               "particles left the domain")
-        self.order = np.argsort(self.lmp.atom("id"))        # local index of particle k (id k + 1)
-        self.identity = bool(np.all(self.order == np.arange(self.n)))
-        self.x, self.v = self.lmp.atom("x"), self.lmp.atom("v")
+        if fluid_force:         # the set-up added fix external's array while it was uninitialised
+            self.lmp.external_force(FLUID_FIX)[:] = 0.0     # memory: zero it and set up again
+            self.lmp.command("run 0")
+        self.fluid_force, self.prepared = fluid_force, True
+        return added
 
     def run(self, steps: int) -> None:
         self.lmp.run(int(steps))
-        self._views()
 
-    def state(self):
-        if self.identity:
-            return self.x, self.v
-        return self.x[self.order], self.v[self.order]
+    @property
+    def dt(self) -> float:
+        return self.lmp.dt
 
-    def add_velocity(self, index, dv) -> None:
-        np.add.at(self.v, self.order[np.asarray(index)], dv)
+    @property
+    def step(self) -> int:
+        return self.lmp.step
+
+    def box(self):
+        """(lo, hi, periodic) of the simulation box [m]."""
+        lo, hi = self.lmp.box()
+        return lo, hi, np.array(self.info.periodic)
+
+    # -- particles --------------------------------------------------------------------
+    def atoms(self, temperature: bool = True) -> Atoms:
+        lmp = self.lmp
+        T = lmp.temperature() if temperature and lmp.nlocal else (np.zeros(0) if temperature else None)
+        return Atoms(lmp.atom("id").astype(np.int64), lmp.atom("x"), lmp.atom("v"), lmp.atom("radius"),
+                     lmp.atom("rmass"), lmp.atom("type"), T)
+
+    def add_velocity(self, local_index, dv) -> None:
+        np.add.at(self.lmp.atom("v"), np.asarray(local_index), dv)
 
     def set_force(self, force) -> None:
-        """Force [N] on each particle (particle order), applied every step until changed."""
-        self.lmp.external_force(FLUID_FIX)[self.order] = force
+        """Force [N] on each local atom, applied every step until changed."""
+        self.lmp.external_force(FLUID_FIX)[:] = force
 
-    def close(self) -> None:
-        self.lmp.close()
+    # -- the DEM's own values -----------------------------------------------------------
+    def type_values(self, prop: str, ntypes: int) -> np.ndarray:
+        """A per-type property/global of the script (youngsModulus, poissonsRatio,
+        thermalCapacity, ...), by type (index 0 = type 1)."""
+        fix = self.info.globals.get(prop)
+        if fix is None:
+            raise ScriptError(f"the script sets no 'fix ... property/global {prop} peratomtype ...'")
+        return np.array([self.lmp.fix_global(fix, k) for k in range(ntypes)])
+
+    def type_pair_values(self, prop: str, ntypes: int) -> np.ndarray:
+        fix = self.info.globals.get(prop)
+        if fix is None:
+            raise ScriptError(f"the script sets no 'fix ... property/global {prop} peratomtypepair ...'")
+        return np.array([[self.lmp.fix_global(fix, a, b) for b in range(ntypes)] for a in range(ntypes)])
+
+    # -- contacts ---------------------------------------------------------------------
+    def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:
+        """Every contact now (see :class:`Contacts`). ``wall_index``: host wall index of each
+        wall/gran fix id; a particle touching several triangles of one mesh wall is one contact
+        (the deepest)."""
+        parts = [self._pair_contacts()]
+        for fix, wall in self.info.walls.items():
+            if wall.primitive is not None:
+                parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix]))
+        mesh_fixes = [f for f, w in self.info.walls.items() if w.meshes]
+        if mesh_fixes:
+            parts.append(self._mesh_contacts(WALL_BASE + wall_index[mesh_fixes[-1]]))
+        return _concat(parts)
+
+    def _local(self, which: str):
+        compute_id, keywords = getattr(self.info, which)
+        a = self.lmp.local_array(compute_id)
+        cols_attr = "pair_cols" if which == "pair_compute" else "wall_cols"
+        if getattr(self, cols_attr) is None:
+            setattr(self, cols_attr, local_columns(keywords, a.shape[1]))
+        return a, getattr(self, cols_attr)
+
+    def _pair_contacts(self) -> Contacts:
+        a, c = self._local("pair_compute")
+        xi, xj = a[:, c["pos"]][:, :3], a[:, c["pos"]][:, 3:]
+        vi, vj = a[:, c["vel"]][:, :3], a[:, c["vel"]][:, 3:]
+        d = xi - xj
+        lo, hi, periodic = self.box()
+        length = hi - lo
+        d = np.where(periodic, d - length * np.round(d / length), d)    # positions come remapped
+        dist = np.linalg.norm(d, axis=1)
+        n = d / np.where(dist > 0, dist, 1.0)[:, None]
+        ids = a[:, c["id"]]
+        if "delta" in c:
+            delta = a[:, c["delta"]][:, 0]
+        else:
+            r = self.lmp.radii_of(ids[:, :2].astype(np.int64))
+            delta = r.sum(axis=1) - dist
+        flux = a[:, c["heatFlux"]][:, 0] if "heatFlux" in c else np.zeros(len(a))
+        return Contacts(ids[:, 0].astype(np.int64), ids[:, 1].astype(np.int64), delta, n,
+                        -np.einsum("ij,ij->i", vi - vj, n), flux)
+
+    def _mesh_contacts(self, wall: int) -> Contacts:
+        a, c = self._local("wall_compute")
+        cp, xp = a[:, c["pos"]][:, :3], a[:, c["pos"]][:, 3:]
+        vw, vp = a[:, c["vel"]][:, :3], a[:, c["vel"]][:, 3:]
+        pid = a[:, c["id"]][:, 2].astype(np.int64)
+        d = xp - cp
+        dist = np.linalg.norm(d, axis=1)
+        n = d / np.where(dist > 0, dist, 1.0)[:, None]
+        delta = a[:, c["delta"]][:, 0] if "delta" in c else self.lmp.radii_of(pid) - dist
+        order = np.lexsort((-delta, pid))                  # deepest triangle of each particle first
+        first = order[np.r_[True, pid[order][1:] != pid[order][:-1]]] if len(pid) else order
+        return Contacts(pid[first], np.full(len(first), wall, np.int64), delta[first], n[first],
+                        -np.einsum("ij,ij->i", vp[first] - vw[first], n[first]), np.zeros(len(first)))
+
+
+def _primitive_contacts(atoms: Atoms, primitive, wall: int) -> Contacts:
+    """Contacts with a fixed primitive wall from geometry: plane ``xplane p`` (etc.) or
+    cylinder ``zcylinder R c1 c2`` (etc.), overlap = radius - distance to the surface."""
+    kind, num = primitive
+    axis = "xyz".index(kind[0])
+    x, r = atoms.x, atoms.radius
+    if kind.endswith("plane"):
+        s = x[:, axis] - num[0]
+        delta = r - np.abs(s)
+        normal = np.zeros((len(x), 3))
+        normal[:, axis] = np.where(s >= 0, 1.0, -1.0)
+    else:
+        other = [k for k in range(3) if k != axis]
+        rad = x[:, other] - np.array(num[1:3])
+        dist = np.linalg.norm(rad, axis=1)
+        unit = rad / np.where(dist > 0, dist, 1.0)[:, None]
+        inside = dist < num[0]
+        delta = r - np.where(inside, num[0] - dist, dist - num[0])
+        normal = np.zeros((len(x), 3))
+        normal[:, other] = np.where(inside[:, None], -unit, unit)
+    on = np.flatnonzero(delta > 0)
+    return Contacts(atoms.id[on], np.full(len(on), wall, np.int64), delta[on], normal[on],
+                    -np.einsum("ij,ij->i", atoms.v[on], normal[on]), np.zeros(len(on)))

@@ -135,6 +135,10 @@ def input_lines(scene: Scene, data_file: Path, skin: float | None = None) -> lis
         kind, side = PLANES[w.plane]
         lines.append(f"fix wall{k} all wall/gran model hertz tangential history primitive "
                      f"type {index[w.material] + 1} {kind} {num(box[side])}")
+    if scene.effects.enduring_conduction:       # LIGGGHTS' own conduction through lasting contacts
+        lines += ["fix m5 all property/global thermalConductivity peratomtype " + " ".join(num(m.conductivity) for m in mats),
+                  "fix m6 all property/global thermalCapacity peratomtype " + " ".join(num(m.heat_capacity) for m in mats),
+                  "fix heat all heat/gran initial_temperature 0"]
     lines += ["fix integrate all nve/sphere", "thermo_style custom step atoms ke", "thermo 100000"]
     return lines
 

@@ -46,6 +46,7 @@ _DECLARATIONS = {
     "lammps_extract_compute": (_vp, [_vp, _cp, _int, _int]),
     "lammps_extract_fix": (_vp, [_vp, _cp, _int, _int, _int, _int]),
     "lammps_get_natoms": (_int, [_vp]),
+    "lammps_extract_variable": (_vp, [_vp, _cp, _cp]),
 }
 _HELPER_DECLARATIONS = {
     "collheat_watch_exit": (None, [_vp, _cp]),
@@ -129,7 +130,8 @@ class Liggghts:
     directory if None. ``check``: try commands in a forked copy first (see the module doc).
     """
 
-    def __init__(self, workdir: str | os.PathLike | None = None, *, check: bool = True):
+    def __init__(self, workdir: str | os.PathLike | None = None, *, check: bool = True,
+                 variables: dict | None = None):
         if not HELPER.is_file():
             raise LiggghtsError(f"{HELPER} is missing: run tools/setup.sh --engines")
         self._tmp = None if workdir else tempfile.TemporaryDirectory(prefix="liggghts-")
@@ -143,6 +145,8 @@ class Liggghts:
         _declare(self.lib, _DECLARATIONS)
         _declare(self.helper, _HELPER_DECLARATIONS)
         args = [b"liggghts", b"-screen", str(self.log).encode(), b"-log", b"none"]
+        for name, value in (variables or {}).items():      # as 'liggghts -var NAME VALUE'
+            args += [b"-var", str(name).encode(), str(value).encode()]
         argv = (_cp * len(args))(*args)
         self.ptr = _vp()
         # A forked copy must be able to call MPI_Finalize without a server of the parent's
@@ -268,6 +272,34 @@ class Liggghts:
         """Time step (s)."""
         return ctypes.cast(self.lib.lammps_extract_global(self.ptr, b"dt"),
                            ctypes.POINTER(ctypes.c_double))[0]
+
+    def variable(self, name: str) -> float:
+        """Value of an equal-style variable."""
+        raw = self.lib.lammps_extract_variable(self.ptr, name.encode(), None)
+        if not raw:
+            raise LiggghtsError(f"no equal-style variable '{name}'")
+        return ctypes.cast(raw, ctypes.POINTER(ctypes.c_double))[0]
+
+    def fix_global(self, fix_id: str, i: int, j: int | None = None) -> float:
+        """Element i (or i, j) of a fix's global vector (array), e.g. of a property/global."""
+        raw = self.lib.lammps_extract_fix(self.ptr, fix_id.encode(), 0, 1 if j is None else 2, i, j or 0)
+        if not raw:
+            raise LiggghtsError(f"fix '{fix_id}' has no global {'vector' if j is None else 'array'}")
+        return ctypes.cast(raw, ctypes.POINTER(ctypes.c_double))[0]
+
+    def box(self):
+        """(lo, hi) corners of the simulation box [m]."""
+        get = lambda name: ctypes.cast(self.lib.lammps_extract_global(self.ptr, name.encode()),
+                                       ctypes.POINTER(ctypes.c_double))[0]
+        lo = np.array([get(f"box{a}lo") for a in "xyz"])
+        hi = np.array([get(f"box{a}hi") for a in "xyz"])
+        return lo, hi
+
+    def radii_of(self, ids) -> np.ndarray:
+        """Radii [m] of the atoms with these ids (any shape)."""
+        lookup = np.zeros(int(self.atom("id").max(initial=0)) + 1)
+        lookup[self.atom("id")] = self.atom("radius")
+        return lookup[np.asarray(ids)]
 
     def atom(self, name: str) -> np.ndarray:
         """Zero-copy view of a per-atom array of the local atoms, in LIGGGHTS' local order:

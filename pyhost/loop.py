@@ -1,19 +1,28 @@
-"""The coupling loop: the DEM advances, the host samples contacts, moves collision heat.
+"""The coupling loop: read this file first.
 
-The DEM is any object with
-    run(steps)                      advance the particles by whole DEM steps,
-    state() -> (x, v)               positions [m] and velocities [m/s], (N, 3), in particle order,
-    add_velocity(index, dv)         change the velocities of some particles [m/s],
-    set_force(F)                    (fluid scenes) force on each particle [N] until changed,
-and the fluid, when the scene has one, a started ``pyhost.openfoam.FluidSolver``;
-the loop builds only what the scene asks for (``Scene.effects_summary``): no contact
-sampling for an isothermal scene without restitution feedback, no heat arrays without a
-heat model. Temperatures live in the host (``self.T``), which is the only place they change.
-How a contact is classified (collision, then enduring) is told in ``pyhost.collisions``.
+A scene's DEM is a LIGGGHTS script (the user's, or the box world generated from case.toml),
+run command by command by ``run_scene``; each ``run N`` becomes ``Coupling.advance(N)``:
+
+    every DEM chunk:   dem.run(n)
+    every sample:      track_particles   (inserted particles get their material's temperature,
+                                          departed ones leave the energy balance)
+                       sample_contacts   (LIGGGHTS' own contact lists; a new contact is a
+                                          collision: impact speed, plugin heat, exchange in Temp;
+                                          an ended one gets the model's restitution if asked;
+                                          a script's fix heat/gran is undone during t_coll)
+    every coupling:    couple_fluid      (fluid force on particles, particles' fraction to fluid)
+    every frame:       write_frame       (history.csv, VTK)
+
+Temperatures live in LIGGGHTS' per-atom ``Temp``: the host reads and writes them there and
+keeps no copy. The loop builds only what the scene asks for (``Scene.effects_summary``): no
+contact sampling for an isothermal scene without restitution feedback. How a contact is
+classified (collision, then enduring) is told in ``pyhost.collisions``.
 """
 from __future__ import annotations
 
 import json
+import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -21,12 +30,22 @@ import numpy as np
 from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
                                temperature_difference)
 from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
-from pyhost.contacts import ContactFinder
-from pyhost.dem_input import Particles, material_index
+from pyhost.dem import Dem
 from pyhost.output import CsvLog, Progress, VtkSeries
+from pyhost.script import ScriptError, parse_run
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
+
+
+@dataclass(frozen=True)
+class HostWall:
+    """A LIGGGHTS wall as the host sees it: its fix id, its real material (index into the
+    scene's materials) and its fixed temperature [K] (NaN: adiabatic)."""
+
+    fix: str
+    material: int
+    temperature: float
 
 
 def layer_pressure_drop(fluid) -> float:
@@ -39,138 +58,223 @@ def layer_pressure_drop(fluid) -> float:
 
 
 class Coupling:
-    """One run of a scene with a DEM engine; ``run()`` returns the summary it also writes."""
+    """The coupled run of a scene on a prepared ``Dem``; ``advance(n)`` runs n DEM steps,
+    ``finish()`` writes and returns the summary.
 
-    def __init__(self, scene, dem, particles: Particles, out: Path, progress_every: float = 5.0, fluid=None):
-        self.scene, self.dem, self.p, self.out = scene, dem, particles, Path(out)
-        self.fluid = fluid              # a started pyhost.openfoam.FluidSolver, or None (dry)
-        self.fluid_frames = VtkSeries(self.out / "vtk", "fluid") if fluid is not None and scene.output.vtk else None
+    ``type_material``: material index of each atom type (index = type; -1: none);
+    ``groups``: (names, function atoms -> group index per atom) for the history columns;
+    ``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
+    ``initial_T``: function (atoms, mask of new atoms) -> their starting temperature [K]
+    (NaN: keep the value LIGGGHTS holds).
+    """
+
+    def __init__(self, scene, dem: Dem, out: Path, *, type_material, groups, walls, initial_T, fluid=None,
+                 end: float | None = None, progress_every: float = 5.0):
+        self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
         self.materials = list(scene.materials.values())
-        self.wall_material = np.array([material_index(scene)[w.material] for w in scene.walls], int)
-        self.T_wall = np.array([w.temperature if w.temperature > 0 and self.effects["wall_heat"] else np.nan
-                                for w in scene.walls])
-        self.T = particles.temperature.astype(float).copy()
-        self.C = particles.mass * np.array([m.heat_capacity for m in self.materials])[particles.material]
+        self.type_material = np.asarray(type_material, int)
+        self.group_names, self.group_of = groups
+        self.initial_T = initial_T
+        self.walls = walls
+        self.wall_index = {w.fix: k for k, w in enumerate(walls)}
+        self.T_wall = np.array([w.temperature if self.effects["wall_heat"] else np.nan for w in walls])
+        self.wall_material = np.array([w.material for w in walls], int)
+        self.capacity = np.array([m.heat_capacity for m in self.materials])
         self.tracker = ContactTracker()
-        d = scene.domain
-        self.contacts = ContactFinder(particles.radius, d.box, d.periodic, [w.plane for w in scene.walls])
-        self.open = {}                  # contact key -> (start time, model t_coll, e, v0)
-        self.t, self.step = 0.0, 0
-        self.totals = dict(collisions=0, wall_collisions=0, heat_moved=0.0, heat_from_walls=0.0,
-                           capped=0, clipped=0, enduring_heat=0.0)
-        self.CT0 = float(np.sum(self.C * self.T))
+        self.open = {}                   # contact key -> (start time, model t_coll, e, v0, normal)
+        self.t0_step = dem.step
+        self.t = dem.step * dem.dt
+        self.steps = 0
+        self.totals = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0,
+                           heat_from_walls=0.0, capped=0, clipped=0, heat_gran_undone=0.0,
+                           inserted=0, departed=0, energy_in=0.0, energy_out=0.0)
+        self.CT_by_id = np.zeros(0)      # m c T of each id at its last sample [J] (energy balance)
+        self.seen = np.zeros(0, bool)
+        self.warned = set()
+        self.heat = self.effects["collision_heat"]
+        self.laws = self.dem_laws()
+        if self.heat and dem.info.heat_gran:
+            self.check_capacities()
+        atoms = dem.atoms(self.heat)
+        self.track_particles(atoms)
+        self.CT0 = self.totals.pop("energy_in")
+        self.totals["energy_in"] = 0.0
         self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS
                                  + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:]))
-        self.groups = [np.flatnonzero(particles.group == k) for k in range(len(scene.particles))]
-        self.history = CsvLog(self.out / "history.csv", ("time", "T_mean", "T_min", "T_max")
-                              + tuple(f"T_group{k}" for k in range(len(self.groups)))
-                              + ("sum_mcT", "heat_from_walls", "collisions", "capped", "clipped")
-                              + (FLUID_COLUMNS if fluid is not None else ()))
+        self.history = CsvLog(self.out / "history.csv", ("time", "particles", "T_mean", "T_min", "T_max")
+                              + tuple(f"T_group{k}" for k in range(len(self.group_names)))
+                              + ("sum_mcT", "heat_from_walls", "energy_in", "energy_out", "collisions",
+                                 "capped", "clipped") + (FLUID_COLUMNS if fluid is not None else ()))
         self.frames = VtkSeries(self.out / "vtk", "particles") if scene.output.vtk else None
-        self.progress = Progress(scene.time.end, progress_every)
+        self.fluid_frames = VtkSeries(self.out / "vtk", "fluid") if fluid is not None and scene.output.vtk else None
+        self.progress = Progress(end or math.inf, progress_every)
+        self.every = dict(sample=scene.time.sample_every if self.effects["contact_extraction"] else 0,
+                          frame=max(1, round(scene.output.every / dem.dt)),
+                          couple=scene.time.couple_every if fluid is not None else 0)
+        if fluid is not None:
+            self.couple_fluid()
+        self.write_frame()
 
-    def run(self) -> dict:
-        tm = self.scene.time
-        n_end = round(tm.end / tm.dem_step)
-        sample = tm.sample_every if self.effects["contact_extraction"] else n_end
-        frame = max(1, round(self.scene.output.every / tm.dem_step))
-        couple = tm.couple_every if self.fluid is not None else n_end
-        try:
-            if self.fluid is not None:
-                self.couple_fluid(couple * tm.dem_step)
-            self.write_frame()
-            while self.step < n_end:
-                n = min(sample - self.step % sample, frame - self.step % frame, couple - self.step % couple,
-                        n_end - self.step)
-                self.dem.run(n)
-                self.step += n
-                self.t = self.step * tm.dem_step
-                if self.effects["contact_extraction"] and self.step % sample == 0:
-                    self.sample_contacts(sample * tm.dem_step)
-                if self.fluid is not None and self.step % couple == 0 and self.step < n_end:
-                    self.couple_fluid(couple * tm.dem_step)
-                if self.step % frame == 0 or self.step == n_end:
-                    self.write_frame()
-                self.progress.update(self.t, f", {self.totals['collisions']} collisions")
-        except BaseException as exc:          # keep what was computed: summary of the run so far
-            self.finish(status=f"stopped at t = {self.t:g} s by {type(exc).__name__}: {exc}")
-            raise
-        return self.finish()
+    def advance(self, n: int) -> None:
+        """n coupled DEM steps: the loop of the module doc."""
+        while n > 0:
+            step = self.dem.step - self.t0_step
+            chunk = min([n] + [k - step % k for k in self.every.values() if k])
+            self.dem.run(chunk)
+            n -= chunk
+            self.steps += chunk
+            step += chunk
+            self.t = self.dem.step * self.dem.dt
+            due = {name: k and step % k == 0 for name, k in self.every.items()}
+            if due["sample"]:
+                atoms = self.dem.atoms(self.heat)
+                self.track_particles(atoms)
+                self.sample_contacts(atoms)
+            if due["couple"]:
+                self.couple_fluid()
+            if due["frame"]:
+                self.write_frame()
+            self.progress.update(self.t, f", {self.totals['collisions']} collisions")
 
-    def couple_fluid(self, duration: float) -> None:
-        """The fluid's force on each particle from the current fluid, then the fluid advanced
-        over the next coupling interval with these particles' fraction and drag."""
-        x, v = self.dem.state()
-        d = self.scene.domain
-        lo, hi = np.array(d.box[0::2]), np.array(d.box[1::2])
-        x = np.where(d.periodic, lo + np.mod(x - lo, hi - lo), x)   # the DEM wraps only at re-neighbouring
-        self.dem.set_force(self.fluid.couple(x, v, 2.0 * self.p.radius, duration))
+    # -- particles ----------------------------------------------------------------------
+    def materials_of(self, types) -> np.ndarray:
+        types = np.asarray(types)
+        mat = np.where(types < len(self.type_material), self.type_material[np.minimum(types, len(self.type_material) - 1)], -1)
+        if (mat < 0).any():
+            bad = sorted(set(types[mat < 0].tolist()))
+            raise ScriptError(f"{self.scene.path}: atom type(s) {bad} have no material: name them in a "
+                              "[materials.NAME] types = [...] list")
+        return mat
 
-    def sample_contacts(self, dt_sample: float) -> None:
-        self.dt_sample = dt_sample
-        x, v = self.dem.state()
-        c = self.contacts(x, v)
+    def track_particles(self, atoms) -> None:
+        """Inserted particles: their material's temperature (if the scene gives one) and their
+        heat content enters the balance; departed ones (deleted, lost) leave it with the heat
+        content of their last sample."""
+        if not self.heat:
+            return
+        ids = atoms.id
+        top = int(ids.max(initial=0)) + 1
+        if top > len(self.seen):
+            grow = max(top, 2 * len(self.seen)) - len(self.seen)
+            self.seen = np.r_[self.seen, np.zeros(grow, bool)]
+            self.CT_by_id = np.r_[self.CT_by_id, np.zeros(grow)]
+        mat = self.materials_of(atoms.type)
+        C = atoms.mass * self.capacity[mat]
+        new = ~self.seen[ids]
+        if new.any():
+            T_set = self.initial_T(atoms, new)
+            atoms.T[new] = np.where(np.isnan(T_set), atoms.T[new], T_set)
+            self.totals["inserted"] += int(new.sum())
+            self.totals["energy_in"] += float(np.sum(C[new] * atoms.T[new]))
+        present = np.zeros(len(self.seen), bool)
+        present[ids] = True
+        gone = self.seen & ~present
+        if gone.any():
+            self.totals["departed"] += int(gone.sum())
+            self.totals["energy_out"] += float(self.CT_by_id[gone].sum())
+            self.seen[gone] = False
+        self.seen[ids] = True
+        self.CT_by_id[ids] = C * atoms.T
+        self.C = C
+
+    # -- contacts -----------------------------------------------------------------------
+    def sample_contacts(self, atoms) -> None:
+        c = self.dem.contacts(atoms, self.wall_index)
         keys = contact_keys(c.i, c.j)
         opened, closed = self.tracker.update(keys)
         if len(opened):
-            self.start_collisions(c, keys, opened)
+            self.start_collisions(atoms, c, keys, opened)
         if len(closed):
-            self.end_collisions(closed, x, v)
-        if self.effects["enduring_conduction"]:
-            self.conduct_enduring(c, keys, dt_sample)
+            self.end_collisions(atoms, closed)
+        if self.heat and self.dem.info.heat_gran and len(c):
+            self.undo_heat_gran(atoms, c, keys)
 
-    def partner_arrays(self, i, j):
-        """Whether each partner j is a wall, and its material index, radius [m], mass [kg]."""
+    def dem_laws(self) -> dict:
+        """The DEM's Hertz law for each pair of atom types, from the script's own values
+        (LIGGGHTS' effective modulus and per-pair restitution)."""
+        n = len(self.type_material) - 1
+        if not self.effects["contact_extraction"] or n < 1:
+            return {}
+        E = self.dem.type_values("youngsModulus", n)
+        nu = self.dem.type_values("poissonsRatio", n)
+        e = self.dem.type_pair_values("coefficientRestitution", n)
+        return {(a, b): DemHertz(1.0 / ((1 - nu[a - 1] ** 2) / E[a - 1] + (1 - nu[b - 1] ** 2) / E[b - 1]),
+                                 float(e[a - 1, b - 1]))
+                for a in range(1, n + 1) for b in range(1, n + 1)}
+
+    def check_capacities(self) -> None:
+        """A script's fix heat/gran integrates Temp with its own thermalCapacity: it must be the
+        scene's heat capacity of each type's material, else the two would disagree on energy."""
+        types = np.flatnonzero(self.type_material >= 0)
+        script = self.dem.type_values("thermalCapacity", int(types.max()))[types - 1]
+        scene = self.capacity[self.type_material[types]]
+        bad = np.flatnonzero(np.abs(script / scene - 1) > 1e-12)
+        if len(bad):
+            t = types[bad[0]]
+            raise ScriptError(f"{self.scene.path}: atom type {t}: the script's thermalCapacity {script[bad[0]]:g} "
+                              f"differs from materials.{list(self.scene.materials)[self.type_material[t]]}"
+                              f".heat_capacity {scene[bad[0]]:g} J/(kg K): give both the same value")
+
+    def partners(self, atoms, i, j):
+        """For contacts between local atoms i and partners j (atom ids, or WALL_BASE + wall):
+        whether j is a wall, j as a local index or wall code, its material, atom type (walls:
+        their LIGGGHTS type), radius [m] and mass [kg] (inf for walls)."""
         wall = j >= WALL_BASE
-        jj = np.where(wall, 0, j)
+        jl = np.where(wall, j, atoms.index(np.where(wall, 0, j)))
         w = np.where(wall, j - WALL_BASE, 0)
-        mat = np.where(wall, self.wall_material[w] if len(self.wall_material) else 0, self.p.material[jj])
-        return wall, mat, np.where(wall, np.inf, self.p.radius[jj]), np.where(wall, np.inf, self.p.mass[jj])
+        jj = np.where(wall, 0, jl)
+        mat_i = self.materials_of(atoms.type[i])
+        wall_mat = np.where(self.wall_material[w] >= 0, self.wall_material[w], mat_i) if len(self.walls) else mat_i
+        mat = np.where(wall, wall_mat, self.materials_of(atoms.type[jj]))
+        wall_type = np.array([self.dem.info.wall_type(wl.fix) or 1 for wl in self.walls] or [1])
+        typ = np.where(wall, wall_type[w], atoms.type[jj])
+        return (wall, jl, mat, typ, np.where(wall, np.inf, atoms.radius[jj]),
+                np.where(wall, np.inf, atoms.mass[jj]))
 
-    def dem_laws(self, mi, mj):
-        """The DEM's contact law for each material pair (LIGGGHTS' effective modulus)."""
-        laws = {}
-        for a, b in set(zip(mi.tolist(), mj.tolist())):
-            A, B = self.materials[a].dem, self.materials[b].dem
-            Y = 1.0 / ((1 - A.poisson_ratio**2) / A.youngs_modulus + (1 - B.poisson_ratio**2) / B.youngs_modulus)
-            laws[a, b] = DemHertz(Y, 0.5 * (A.restitution + B.restitution))
-        return laws
-
-    def start_collisions(self, c, keys, rows) -> None:
-        i, j = c.i[rows], c.j[rows]
-        wall, mj, R_j, m_j = self.partner_arrays(i, j)
-        mi, R_i, m_i = self.p.material[i], self.p.radius[i], self.p.mass[i]
+    def start_collisions(self, atoms, c, keys, rows) -> None:
+        i = atoms.index(c.i[rows])
+        wall, jl, mj, tj, R_j, m_j = self.partners(atoms, i, c.j[rows])
+        mi, ti, R_i, m_i = self.materials_of(atoms.type[i]), atoms.type[i], atoms.radius[i], atoms.mass[i]
         R_eff = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
         m_eff = np.where(wall, m_i, m_i * m_j / np.where(wall, 1.0, m_i + m_j))
-        v0 = np.empty(len(rows))
-        for (a, b), law in self.dem_laws(mi, mj).items():
-            s = (mi == a) & (mj == b)
-            v0[s] = law.impact_speed(c.delta[rows][s], c.approach[rows][s], R_eff[s], m_eff[s],
-                                     window=self.dt_sample)
+        delta, approach = c.delta[rows], c.approach[rows]
+        v0 = np.abs(approach)
+        if self.dem.info.pair_model == "hertz":
+            for (a, b) in set(zip(ti.tolist(), tj.tolist())):
+                s = (ti == a) & (tj == b)
+                v0[s] = self.laws[a, b].impact_speed(delta[s], approach[s], R_eff[s], m_eff[s],
+                                                     window=self.every["sample"] * self.dem.dt)
+        elif "model" not in self.warned:
+            self.warned.add("model")
+            print(f"warning: the DEM's normal model is '{self.dem.info.pair_model}', not hertz: impact speeds "
+                  "are the approach speeds at the first sample in contact, not integrated back to touch")
         models = self.scene.effects.heat_models
         model = models[0] if models else "none"
         moved = e = t_coll = np.zeros(len(rows))
         side = {}
-        if models:
+        if self.heat:
             args = (self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0, np.ones(len(rows)))
             G, e, t_coll = evaluate(model, *args)                               # Q per kelvin [J/K]
             if len(models) > 1:         # side columns: the same collisions at the same dT, nothing moved
-                dT = temperature_difference(self.T, i, j, self.T_wall)
+                dT = temperature_difference(atoms.T, i, jl, self.T_wall)
                 side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}
-            moved, capped, from_walls = exchange_heat(self.T, self.C, i, j, G, self.T_wall)
+            moved, capped, from_walls = exchange_heat(atoms.T, self.C, i, jl, G, self.T_wall)
             self.totals["capped"] += capped
             self.totals["heat_from_walls"] += from_walls
             self.totals["heat_moved"] += float(np.abs(moved[~wall]).sum())
             by_model = self.heat_by_model()
             for m, q in zip(models, [moved] + list(side.values())):
                 by_model[m] += float(np.abs(q[~wall]).sum())
+        normal = c.normal[rows]
         for k, key in enumerate(keys[rows]):
-            self.open[int(key)] = (self.t, t_coll[k], e[k], v0[k])
+            self.open[int(key)] = (self.t, t_coll[k], e[k], v0[k], normal[k])
         self.totals["collisions"] += len(rows)
-        self.totals["wall_collisions"] += int(wall.sum())
-        self.collisions.write_columns(time=np.full(len(rows), self.t), i=i + 1, j=np.where(wall, 0, j + 1),
-                                      wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
+        self.totals["particle_wall"] += int(wall.sum())
+        self.totals["particle_particle"] += int((~wall).sum())
+        self.collisions.write_columns(time=np.full(len(rows), self.t), i=c.i[rows],
+                                      j=np.where(wall, 0, c.j[rows]),
+                                      wall=np.where(wall, c.j[rows] - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
                                       t_coll=t_coll, model=np.full(len(rows), model), **side)
 
     def heat_by_model(self) -> dict:
@@ -178,83 +282,142 @@ class Coupling:
         that moved it and the side models on the same collisions."""
         return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
 
-    def end_collisions(self, closed, x, v) -> None:
+    def end_collisions(self, atoms, closed) -> None:
         info = [self.open.pop(int(k)) for k in closed]
-        if not self.scene.effects.restitution_feedback or self.scene.effects.contact_heat == "none":
+        if not self.scene.effects.restitution_feedback or not self.heat:
             return
-        i = (closed >> 31).astype(int)
-        j = (closed & ((1 << 31) - 1)).astype(int)
-        wall, _, _, m_j = self.partner_arrays(i, j)
-        jj = np.where(wall, 0, j)
-        normal = np.zeros((len(i), 3))
-        for k in np.flatnonzero(wall):
-            plane = self.scene.walls[j[k] - WALL_BASE].plane
-            normal[k, "xyz".index(plane[0])] = 1.0 if plane.endswith("lo") else -1.0
-        d = x[i] - x[jj]
+        ids_i = (closed >> 31).astype(np.int64)
+        ids_j = (closed & ((1 << 31) - 1)).astype(np.int64)
+        i = atoms.index(ids_i)
+        here = i >= 0
+        wall, jl, _, _, _, m_j = self.partners(atoms, np.maximum(i, 0), ids_j)
+        here &= wall | (jl >= 0)
+        normal = np.array([inf[4] for inf in info]).reshape(-1, 3)
+        jj = np.where(wall, 0, np.maximum(jl, 0))
+        d = atoms.x[np.maximum(i, 0)] - atoms.x[jj]
+        lo, hi, periodic = self.dem.box()
+        d = np.where(periodic, d - (hi - lo) * np.round(d / (hi - lo)), d)
         normal[~wall] = d[~wall] / np.linalg.norm(d[~wall], axis=1)[:, None]
         e = np.array([inf[2] for inf in info])
         v0 = np.array([inf[3] for inf in info])
-        v_j = np.where(wall[:, None], 0.0, v[jj])
-        dv_i, dv_j, clipped = restitution_impulse(v[i], v_j, self.p.mass[i], m_j, normal, e, v0)
+        v_j = np.where(wall[:, None], 0.0, atoms.v[jj])
+        dv_i, dv_j, clipped = restitution_impulse(atoms.v[np.maximum(i, 0)], v_j, atoms.mass[np.maximum(i, 0)],
+                                                  m_j, normal, e, v0)
         self.totals["clipped"] += clipped
-        self.dem.add_velocity(i, dv_i)
-        if (~wall).any():
-            self.dem.add_velocity(j[~wall], dv_j[~wall])
+        self.dem.add_velocity(i[here], dv_i[here])
+        pair = here & ~wall
+        if pair.any():
+            self.dem.add_velocity(jl[pair], dv_j[pair])
 
-    def conduct_enduring(self, c, keys, dt_sample) -> None:
-        """Conduction through contacts older than their collision, h = 4 k_i k_j/(k_i + k_j) A^1/2
-        (the enduring-contact law of LIGGGHTS' heat/gran) with A = pi R* delta, over the part
-        of the sample interval that lies beyond the collision's own duration."""
-        age = np.array([self.t - self.open[int(k)][0] - self.open[int(k)][1] for k in keys])
-        rows = np.flatnonzero(age > 0)
+    def undo_heat_gran(self, atoms, c, keys) -> None:
+        """The script's fix heat/gran conducts through every contact; during a collision's
+        model duration t_coll the collision heat already stands for that time, so what heat/gran
+        moved then is taken back: flux at this sample [W] times the part of the sample interval
+        inside [start, start + t_coll] (exact when sampling every step)."""
+        dt_s = self.every["sample"] * self.dem.dt
+        info = [self.open[int(k)] for k in keys]
+        start = np.array([inf[0] for inf in info])
+        t_coll = np.array([inf[1] for inf in info])
+        tau = np.clip(start + t_coll - (self.t - dt_s), 0.0, dt_s)
+        rows = np.flatnonzero((tau > 0) & (c.j < WALL_BASE))
         if not len(rows):
             return
-        i, j = c.i[rows], c.j[rows]
-        wall, mj, R_j, _ = self.partner_arrays(i, j)
-        k_i = np.array([m.conductivity for m in self.materials])[self.p.material[i]]
-        k_j = np.array([m.conductivity for m in self.materials])[mj]
-        R_i = self.p.radius[i]
-        R_eff = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
-        h = 4 * k_i * k_j / (k_i + k_j) * np.sqrt(np.pi * R_eff * c.delta[rows])
-        moved, capped, from_walls = exchange_heat(self.T, self.C, i, j, h * np.minimum(age[rows], dt_sample),
-                                                  self.T_wall)
-        self.totals["enduring_heat"] += float(np.abs(moved).sum())
-        self.totals["heat_from_walls"] += from_walls
-        self.totals["capped"] += capped
+        i, j = atoms.index(c.i[rows]), atoms.index(c.j[rows])
+        q = c.heat_flux[rows] * tau[rows]                   # heat heat/gran moved into i [J]
+        np.subtract.at(atoms.T, i, q / self.C[i])
+        np.add.at(atoms.T, j, q / self.C[j])
+        self.totals["heat_gran_undone"] += float(np.abs(q).sum())
 
-    def bed_state(self, x) -> tuple:
+    # -- fluid --------------------------------------------------------------------------
+    def couple_fluid(self) -> None:
+        """The fluid's force on each particle from the current fluid, then the fluid advanced
+        over the next coupling interval with these particles' fraction and drag."""
+        atoms = self.dem.atoms(temperature=False)
+        lo, hi, periodic = self.dem.box()
+        x = np.where(periodic, lo + np.mod(atoms.x - lo, hi - lo), atoms.x)   # the DEM wraps only at re-neighbouring
+        self.dem.set_force(self.fluid.couple(x, atoms.v, 2.0 * atoms.radius, self.every["couple"] * self.dem.dt))
+
+    def bed_state(self, atoms) -> tuple:
         """The fluid columns of history.csv: the superficial inlet velocity [m/s]; the pressure
         drop the particles cause [Pa], mean p of the lowest cell layer less that of the highest,
         less the fluid's own hydrostatic head between them; the bed height [m], twice the mean
         particle centre height above the box floor (exact for a uniform bed)."""
         z = self.fluid.cell_centres[:, 2]
         head = self.scene.fluid.density * self.scene.domain.gravity[2] * (z.max() - z.min())
+        floor = self.dem.box()[0][2]
         return (float(self.scene.fluid.inlet_at(self.t)), layer_pressure_drop(self.fluid) + head,
-                2.0 * float(np.mean(x[:, 2] - self.scene.domain.box[4])))
+                2.0 * float(np.mean(atoms.x[:, 2] - floor)))
 
+    # -- output -------------------------------------------------------------------------
     def write_frame(self) -> None:
         tot = self.totals
-        x, v = self.dem.state() if self.frames is not None or self.fluid is not None else (None, None)
-        group_means = tuple(float(np.sum(self.C[g] * self.T[g]) / np.sum(self.C[g])) for g in self.groups)
-        self.history.write([(self.t, float(self.T.mean()), float(self.T.min()), float(self.T.max()))
-                            + group_means + (float(np.sum(self.C * self.T)), tot["heat_from_walls"],
-                                             tot["collisions"], tot["capped"], tot["clipped"])
-                            + (self.bed_state(x) if self.fluid is not None else ())])
+        atoms = self.dem.atoms(self.heat)
+        T = atoms.T if self.heat else np.full(len(atoms.id), np.nan)
+        if self.heat:
+            self.track_particles(atoms)
+        C = self.C if self.heat else np.ones(len(atoms.id))
+        group = self.group_of(atoms)
+        means = tuple(float(np.sum(C[group == k] * T[group == k]) / max(np.sum(C[group == k]), 1e-300))
+                      if np.any(group == k) else math.nan for k in range(len(self.group_names)))
+        stats = (float(T.mean()), float(T.min()), float(T.max())) if len(T) else (math.nan,) * 3
+        self.history.write([(self.t, len(atoms.id)) + stats + means
+                            + (float(np.sum(C * T)), tot["heat_from_walls"], tot["energy_in"], tot["energy_out"],
+                               tot["collisions"], tot["capped"], tot["clipped"])
+                            + (self.bed_state(atoms) if self.fluid is not None else ())])
         if self.frames is not None:
-            self.frames.write(self.t, x, id=np.arange(1, len(x) + 1), radius=self.p.radius, velocity=v,
-                              temperature=self.T)
+            self.frames.write(self.t, atoms.x, id=atoms.id, type=atoms.type, radius=atoms.radius,
+                              velocity=atoms.v, temperature=T)
         if self.fluid_frames is not None:
             p, u = self.fluid.fields()
             self.fluid_frames.write(self.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)
 
     def finish(self, status: str = "completed") -> dict:
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
-        CT = float(np.sum(self.C * self.T))
         self.heat_by_model()
-        summary = dict(self.totals, status=status, time=self.t, steps=self.step, sum_mcT_start=self.CT0,
-                       sum_mcT_end=CT,
-                       energy_balance_error=(CT - self.CT0 - self.totals["heat_from_walls"]) / self.CT0)
+        summary = dict(self.totals, status=status, time=self.t, steps=self.steps, groups=self.group_names)
+        if self.heat:
+            atoms = self.dem.atoms(True)
+            self.track_particles(atoms)
+            CT = float(np.sum(self.C * atoms.T))
+            t = self.totals
+            summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=(
+                CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]) / self.CT0)
         (self.out / "summary.json").write_text(json.dumps(summary, indent=1))
         self.collisions.close()
         self.history.close()
         return summary
+
+
+def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end: float | None = None,
+              max_time: float | None = None, progress_every: float = 5.0, log=print, **particles) -> dict:
+    """Run a script's commands on ``dem``; each ``run N`` is N coupled steps (steps beyond
+    ``max_time`` [s] of coupled time, for smoke runs, are cut). ``walls_of(dem)`` gives the
+    HostWalls once the script's walls exist; ``particles``: type_material, groups and
+    initial_T of ``Coupling``. Returns the summary, also written when a step fails."""
+    coupling, max_steps = None, None
+    effects = scene.effects_summary()
+    try:
+        for cmd in commands:
+            if cmd.name != "run":
+                dem.command(cmd)
+                continue
+            run = parse_run(cmd)
+            if coupling is None:
+                added = dem.prepare(heat=effects["collision_heat"], contacts=effects["contact_extraction"],
+                                    fluid_force=fluid is not None)
+                log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
+                coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
+                                    progress_every=progress_every, **particles)
+                max_steps = None if max_time is None else round(max_time / dem.dt)
+            n = dem.steps(run.steps, run.upto)
+            if max_steps is not None:
+                n = min(n, max_steps - coupling.steps)
+            if n > 0:
+                coupling.advance(n)
+    except BaseException as exc:          # keep what was computed: summary of the run so far
+        if coupling is not None:
+            coupling.finish(status=f"stopped at t = {coupling.t:g} s by {type(exc).__name__}: {exc}")
+        raise
+    if coupling is None:
+        raise ScriptError(f"{scene.path}: the script has no 'run' command: nothing to simulate")
+    return coupling.finish()

@@ -93,7 +93,8 @@ class Effects:
                                     "moves the temperatures (and gives e), the others are side columns")
     heat_path: str = spec("in:exact,fast", "fast", "plugin evaluation path")
     restitution_feedback: bool = spec(default=False, doc="apply the model's e(v0) at contact end")
-    enduring_conduction: bool = spec(default=False, doc="conduct through contacts that outlast a collision")
+    enduring_conduction: bool = spec(default=False, doc="box scenes: LIGGGHTS' fix heat/gran conducts through "
+                                                         "particle contacts that outlast a collision")
     wall_heat: bool = spec(default=True, doc="collisions with walls at a fixed temperature exchange heat")
 
     @property
@@ -123,6 +124,9 @@ class Material:
     dem: DemContact = spec(doc="the DEM's softened contact")
     b1: float = spec(">0", 1.1, "mean pressure at first yield / Y [-]")
     b2: float = spec(">0", 2.8, "fully plastic mean pressure / Y [-]")
+    types: list = spec(default=[], doc="LIGGGHTS atom types made of this material (script scenes)")
+    temperature: float = spec(">=0", 0.0, "initial temperature of its particles [K] (script scenes); "
+                                           "0 keeps the script's own Temp values")
 
 
 @dataclass(frozen=True)
@@ -139,8 +143,9 @@ class Particles:
 
 @dataclass(frozen=True)
 class Wall:
-    plane: str = spec("in:xlo,xhi,ylo,yhi,zlo,zhi", doc="which face of the box")
     material: str = spec(doc="key of [materials]")
+    plane: str = spec("in:,xlo,xhi,ylo,yhi,zlo,zhi", "", "which face of the box (box scenes)")
+    fix: str = spec(default="", doc="id of the script's fix wall/gran, primitive or mesh (script scenes)")
     temperature: float = spec(">=0", 0.0, "fixed temperature [K]; 0 means adiabatic")
 
 
@@ -174,9 +179,17 @@ class Fluid:
 
 
 @dataclass(frozen=True)
+class Dem:
+    script: str = spec(default="", doc="the user's LIGGGHTS input script, relative to the case folder; "
+                                       "run as written, each 'run N' becoming N coupled steps")
+    variables: dict = spec(default={}, doc="LIGGGHTS index variables set as with 'liggghts -var NAME VALUE'")
+    test_variables: dict = spec(default={}, doc="variables of the -test smoke run (added to variables)")
+
+
+@dataclass(frozen=True)
 class Time:
-    dem_step: float = spec(">0", doc="DEM time step [s]")
-    end: float = spec(">0", doc="simulated time [s]")
+    dem_step: float = spec(">=0", 0.0, "DEM time step [s] (box scenes; a script sets its own)")
+    end: float = spec(">=0", 0.0, "simulated time [s] (box scenes; a script's runs set it)")
     sample_every: int = spec(">0", 1, "DEM steps between contact samples")
     couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
@@ -200,13 +213,24 @@ class Scene:
     walls: list
     fluid: Fluid | None
     output: Output
+    dem: Dem = Dem()
+
+    @property
+    def folder(self) -> Path:
+        """The case folder: a script runs there, its relative paths are read from there."""
+        return Path(self.path).resolve().parent
+
+    @property
+    def scripted(self) -> bool:
+        """The DEM is the user's own LIGGGHTS script (else the box world generated from the scene)."""
+        return bool(self.dem.script)
 
     def effects_summary(self) -> dict:
         """What the host builds for this scene."""
         heat = bool(self.effects.heat_models)
         return dict(
             fluid_solver=self.effects.fluid,
-            contact_extraction=heat or self.effects.restitution_feedback or self.effects.enduring_conduction,
+            contact_extraction=heat or self.effects.restitution_feedback,
             collision_heat=heat,
             restitution_feedback=self.effects.restitution_feedback,
             enduring_conduction=self.effects.enduring_conduction,
@@ -268,7 +292,7 @@ def _inlet_table(fluid, file):
         raise SceneError(f"{key}: times must increase, got {times!r}")
 
 
-SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output")
+SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output", "dem")
 
 
 def load_scene(path) -> Scene:
@@ -284,23 +308,104 @@ def load_scene(path) -> Scene:
     for key in data:
         if key not in SECTIONS:
             raise SceneError(f"{file}: {key}: unknown section; known: {', '.join(SECTIONS)}")
-    for key in ("materials", "particles", "domain", "time"):
+    dem = _build(Dem, data.get("dem", {}), "dem", file)
+    scripted = bool(dem.script)
+    required = ("materials",) if scripted else ("materials", "particles", "domain", "time")
+    for key in required:
         if key not in data:
             raise SceneError(f"{file}: {key}: missing section")
+    if scripted:
+        for key in ("particles", "domain"):
+            if key in data:
+                raise SceneError(f"{file}: {key}: not used with dem.script (the script places the particles "
+                                 "and sets the domain): remove it")
+        _script_keys(dem, path, file)
     effects = _build(Effects, data.get("effects", {}), "effects", file)
+    if not isinstance(data["materials"], dict) or not data["materials"]:
+        raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
     materials = {name: _build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
     for name, m in materials.items():
         if m.b2 <= m.b1:
             raise SceneError(f"{file}: materials.{name}.b2: must exceed b1 ({m.b1}), got {m.b2}")
+    if not isinstance(data.get("walls", []), list):
+        raise SceneError(f"{file}: walls: must be [[walls]] tables")
+    walls = [_build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+    if scripted:
+        particles, domain = [], None
+        _types(materials, walls, file)
+    else:
+        particles, domain = _box_world(data, materials, walls, file)
+    for k, item in enumerate(walls):
+        if item.material not in materials:
+            raise SceneError(f"{file}: walls[{k}].material: unknown material {item.material!r}; "
+                             f"known: {', '.join(materials)}")
+    time = _build(Time, data.get("time", {}), "time", file)
+    if not scripted:
+        for key in ("dem_step", "end"):
+            if not getattr(time, key) > 0:
+                raise SceneError(f"{file}: time.{key}: must be > 0, got {getattr(time, key)!r}")
+        if time.dem_step >= time.end:
+            raise SceneError(f"{file}: time.dem_step: must be below time.end ({time.end}), got {time.dem_step}")
+    fluid = _build(Fluid, data["fluid"], "fluid", file) if "fluid" in data else None
+    if effects.restitution_feedback and (not effects.heat_models or effects.heat_models[0] not in MODELS):
+        raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model ({', '.join(sorted(MODELS))}) "
+                         f"first in effects.contact_heat; comparison models give no restitution")
+    if effects.fluid and fluid is None:
+        raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
+    if effects.fluid and scripted:
+        raise SceneError(f"{file}: effects.fluid: not yet available with dem.script (only the generated box "
+                         "world couples a fluid so far)")
+    if fluid is not None and (len(fluid.cells) != 3 or not all(isinstance(n, int) and n > 0 for n in fluid.cells)):
+        raise SceneError(f"{file}: fluid.cells: must be 3 positive integers, got {fluid.cells!r}")
+    if fluid is not None and fluid.inlet_table:
+        _inlet_table(fluid, file)
+    output = _build(Output, data.get("output", {}), "output", file)
+    return Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem)
+
+
+def _script_keys(dem, path, file):
+    script = path.resolve().parent / dem.script
+    if not script.is_file():
+        raise SceneError(f"{file}: dem.script: no such file {str(script)!r}")
+    for where in ("variables", "test_variables"):
+        for name, value in getattr(dem, where).items():
+            if isinstance(value, bool) or not isinstance(value, (str, int, float)) or not str(value).strip():
+                raise SceneError(f"{file}: dem.{where}.{name}: must be a number or a word, got {value!r}")
+
+
+def _types(materials, walls, file):
+    """Script scenes: each material names its atom types, no type twice; walls name a fix."""
+    owner = {}
+    for name, m in materials.items():
+        for t in m.types:
+            if isinstance(t, bool) or not isinstance(t, int) or t < 1:
+                raise SceneError(f"{file}: materials.{name}.types: atom types are integers >= 1, got {t!r}")
+            if t in owner:
+                raise SceneError(f"{file}: materials.{name}.types: type {t} is already made of {owner[t]!r}")
+            owner[t] = name
+    for k, w in enumerate(walls):
+        if not w.fix or w.plane:
+            raise SceneError(f"{file}: walls[{k}]: a script scene names a LIGGGHTS wall by fix = \"ID\" "
+                             "(the id of its fix wall/gran), not by plane")
+
+
+def _box_world(data, materials, walls, file):
+    """The [[particles]] groups and the [domain] of a scene whose DEM the host generates."""
+    for name, m in materials.items():
+        if m.types or m.temperature:
+            raise SceneError(f"{file}: materials.{name}: 'types' and 'temperature' belong to script scenes "
+                             "(dem.script); here [[particles]] give them")
     if not isinstance(data["particles"], list) or not data["particles"]:
         raise SceneError(f"{file}: particles: must be one or more [[particles]] tables")
     particles = [_build(Particles, p, f"particles[{k}]", file) for k, p in enumerate(data["particles"])]
-    walls = [_build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
-    for where, items in (("particles", particles), ("walls", walls)):
-        for k, item in enumerate(items):
-            if item.material not in materials:
-                raise SceneError(f"{file}: {where}[{k}].material: unknown material {item.material!r}; "
-                                 f"known: {', '.join(materials)}")
+    for k, w in enumerate(walls):
+        if not w.plane or w.fix:
+            raise SceneError(f"{file}: walls[{k}]: a box scene names its wall by plane = \"zlo\" (etc.), "
+                             "not by fix")
+    for k, item in enumerate(particles):
+        if item.material not in materials:
+            raise SceneError(f"{file}: particles[{k}].material: unknown material {item.material!r}; "
+                             f"known: {', '.join(materials)}")
     for k, p in enumerate(particles):
         if bool(p.region) == bool(p.positions):
             raise SceneError(f"{file}: particles[{k}]: give either region or positions")
@@ -314,18 +419,4 @@ def load_scene(path) -> Scene:
     domain = _build(Domain, data["domain"], "domain", file)
     _box(domain.box, "domain.box", file)
     _box(domain.gravity, "domain.gravity", file, 3)
-    time = _build(Time, data["time"], "time", file)
-    if time.dem_step >= time.end:
-        raise SceneError(f"{file}: time.dem_step: must be below time.end ({time.end}), got {time.dem_step}")
-    fluid = _build(Fluid, data["fluid"], "fluid", file) if "fluid" in data else None
-    if effects.restitution_feedback and (not effects.heat_models or effects.heat_models[0] not in MODELS):
-        raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model ({', '.join(sorted(MODELS))}) "
-                         f"first in effects.contact_heat; comparison models give no restitution")
-    if effects.fluid and fluid is None:
-        raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
-    if fluid is not None and (len(fluid.cells) != 3 or not all(isinstance(n, int) and n > 0 for n in fluid.cells)):
-        raise SceneError(f"{file}: fluid.cells: must be 3 positive integers, got {fluid.cells!r}")
-    if fluid is not None and fluid.inlet_table:
-        _inlet_table(fluid, file)
-    output = _build(Output, data.get("output", {}), "output", file)
-    return Scene(path, effects, materials, particles, domain, time, walls, fluid, output)
+    return particles, domain

@@ -23,9 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.dem import SceneDem
+from pyhost.commands.run import simulate
 from pyhost.dem_input import input_lines, place_particles, write_data
-from pyhost.loop import Coupling
 from pyhost.scene import load_scene
 
 CASE = Path(__file__).resolve().parents[1] / "cases" / "hot-cold-box" / "case.toml"
@@ -39,13 +38,8 @@ def variant(scene, end, **effects):
 
 
 def run_host(scene, out: Path):
-    particles = place_particles(scene)
-    dem = SceneDem(scene, particles, out / "dem")
     t = time.perf_counter()
-    try:
-        summary = Coupling(scene, dem, particles, out, progress_every=1e9).run()
-    finally:
-        dem.close()
+    summary = simulate(scene, out.resolve(), progress_every=1e9)
     return time.perf_counter() - t, summary
 
 

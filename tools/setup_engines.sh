@@ -16,7 +16,7 @@ out=$top/.setup
 sudo=""
 [ "$(id -u)" = 0 ] || sudo=sudo
 
-packages=(liggghts libliggghts-dev openfoam libopenfoam openfoam-examples
+packages=(liggghts libliggghts-dev liggghts-doc openfoam libopenfoam openfoam-examples
           libopenmpi-dev openmpi-bin g++ make flex bzip2)
 missing=()
 for p in "${packages[@]}"; do

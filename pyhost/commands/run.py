@@ -4,9 +4,12 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
+
+import numpy as np
 
 HELP = "run a case: DEM (+ fluid) with collision heat as its case.toml asks"
 
@@ -43,37 +46,127 @@ def start_fluid(scene, folder: Path):
     return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min).start()
 
 
+def box_world(scene, out: Path, fluid_force: bool):
+    """The generated DEM of a box scene: its script (run for time.end) and how the host sees
+    its particles: one atom type per material, groups = the [[particles]] tables, walls
+    ``wall<k>`` = the scene's [[walls]]."""
+    from pyhost.dem_input import input_lines, place_particles, write_data
+    from pyhost.loop import HostWall
+
+    folder = out / "dem"
+    folder.mkdir(parents=True, exist_ok=True)
+    particles = place_particles(scene)
+    data = write_data(folder / "particles.data", scene, particles)
+    script = folder / "in.dem"
+    steps = round(scene.time.end / scene.time.dem_step)
+    script.write_text("\n".join(["atom_modify sort 0 0"] + input_lines(scene, data) + [f"run {steps}"]) + "\n")
+    index = {name: k for k, name in enumerate(scene.materials)}
+    T_by_id = np.r_[np.nan, particles.temperature]
+    group_by_id = np.r_[-1, particles.group]
+    names = [f"{g.material} {g.temperature:g} K" for g in scene.particles]
+    walls = [HostWall(f"wall{k}", index[w.material], w.temperature if w.temperature > 0 else np.nan)
+             for k, w in enumerate(scene.walls)]
+    return script, dict(type_material=[-1] + list(range(len(index))),
+                        groups=(names, lambda atoms: group_by_id[atoms.id]),
+                        initial_T=lambda atoms, new: T_by_id[atoms.id[new]],
+                        walls_of=lambda dem: walls)
+
+
+def user_script(scene):
+    """How the host sees the particles of a user's script: each atom type's material from
+    [materials.NAME] types, groups = materials, walls = the scene's [[walls]] (by fix id) and
+    every other wall/gran fix of the script as an adiabatic wall."""
+    from pyhost.loop import HostWall
+    from pyhost.scene import SceneError
+
+    names = list(scene.materials)
+    used = {w.material for w in scene.walls}
+    for name, m in scene.materials.items():
+        if not m.types and name not in used:
+            raise SceneError(f"{scene.path}: materials.{name}.types: the material is used by no atom type "
+                             "and no wall")
+    top = max((t for m in scene.materials.values() for t in m.types), default=0)
+    type_material = np.full(top + 1, -1)
+    for k, m in enumerate(scene.materials.values()):
+        type_material[m.types] = k
+    T_material = np.array([m.temperature if m.temperature > 0 else np.nan for m in scene.materials.values()])
+
+    def walls_of(dem):
+        known = dem.info.walls
+        named = {}
+        for k, w in enumerate(scene.walls):
+            if w.fix not in known:
+                raise SceneError(f"{scene.path}: walls[{k}].fix: the script has no fix wall/gran {w.fix!r} "
+                                 f"before its first run; its walls: {', '.join(known) or 'none'}")
+            named[w.fix] = HostWall(w.fix, names.index(w.material), w.temperature if w.temperature > 0 else np.nan)
+        for fix in known:
+            if fix not in named:
+                print(f"LIGGGHTS wall {fix!r} has no [[walls]] entry: adiabatic for collision heat")
+        mesh = [f for f, w in known.items() if w.meshes]
+        if len(mesh) > 1:
+            print(f"warning: LIGGGHTS lists the contacts of one mesh wall fix only ({mesh[-1]!r}); "
+                  f"collisions with {', '.join(mesh[:-1])} are not seen")
+        return [named.get(f, HostWall(f, -1, np.nan)) for f in known]
+
+    return dict(type_material=type_material,
+                groups=(names, lambda atoms: type_material[np.minimum(atoms.type, top)]),
+                initial_T=lambda atoms, new: T_material[type_material[np.minimum(atoms.type[new], top)]],
+                walls_of=walls_of)
+
+
+def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None) -> dict:
+    """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
+    world, with the fluid if the scene has one. ``wrap(dem)`` may stand in front of the DEM
+    (tests inject faults with it). Returns the summary."""
+    from pyhost.dem import Dem
+    from pyhost.dem_input import dem_collision_time
+    from pyhost.loop import run_scene
+    from pyhost.script import read_script
+
+    effects = scene.effects_summary()
+    max_time = scene.time.test_end or None if (test and scene.scripted) else None
+    if scene.scripted:
+        script, particles = scene.folder / scene.dem.script, user_script(scene)
+        variables = dict(scene.dem.variables, **(scene.dem.test_variables if test else {}))
+    else:
+        t_c = dem_collision_time(scene, 1.0)
+        if scene.time.dem_step > t_c / 20:
+            print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
+                  f"({t_c:.3g} s) with fewer than 20 steps")
+        script, particles = box_world(scene, out, effects["fluid_solver"])
+        variables = {}
+    commands = read_script(script, scene.folder)
+    fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None
+    cwd = os.getcwd()
+    try:
+        os.chdir(scene.folder)          # the script's relative paths, as with 'liggghts -in' there
+        dem = Dem(out / "dem", variables=variables)
+        try:
+            return run_scene(scene, wrap(dem) if wrap else dem, commands, out, fluid=fluid, max_time=max_time,
+                             end=None if scene.scripted else scene.time.end, progress_every=progress_every,
+                             **particles)
+        finally:
+            dem.lmp.close()
+    finally:
+        os.chdir(cwd)
+        if fluid is not None:
+            fluid.stop()
+
+
 def run(args) -> int:
-    from pyhost.dem import SceneDem
-    from pyhost.dem_input import dem_collision_time, place_particles
-    from pyhost.loop import Coupling
     from pyhost.scene import load_scene
 
     scene = load_scene(args.case / "case.toml")
-    if args.test:
+    if args.test and not scene.scripted:
         end = scene.time.test_end or scene.time.end / 10
         scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=end))
     effects = scene.effects_summary()
-    out = args.out or args.case / "output"
+    out = (args.out or args.case / "output").resolve()
     out.mkdir(parents=True, exist_ok=True)
     print("scene:", json.dumps(resolved(scene), indent=1, default=str))
     print("active effects:", ", ".join(k for k, on in effects.items() if on) or "none (plain DEM)")
     (out / "scene.json").write_text(json.dumps(resolved(scene), indent=1, default=str))
-    particles = place_particles(scene)
-    t_c = dem_collision_time(scene, 1.0)
-    if scene.time.dem_step > t_c / 20:
-        print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
-              f"({t_c:.3g} s) with fewer than 20 steps")
-    fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None
-    try:
-        dem = SceneDem(scene, particles, out / "dem", fluid_force=fluid is not None)
-        try:
-            summary = Coupling(scene, dem, particles, out, fluid=fluid).run()
-        finally:
-            dem.close()
-    finally:
-        if fluid is not None:
-            fluid.stop()
+    summary = simulate(scene, out, test=args.test)
     print("summary:", json.dumps(summary, indent=1))
     if scene.output.pictures:        # own process: see pyhost/commands/pictures.py
         drawn = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(out)])

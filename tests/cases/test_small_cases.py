@@ -100,16 +100,11 @@ class Interrupting:
 
 
 def test_results_so_far_survive_a_failure(tmp_path):
-    from pyhost.dem import SceneDem
-    from pyhost.dem_input import place_particles
-    from pyhost.loop import Coupling
+    from pyhost.commands.run import simulate
 
     scene = load_scene(CASES / "hot-cold-box" / "case.toml")
-    p = place_particles(scene)
-    dem = SceneDem(scene, p, tmp_path / "dem")
     with pytest.raises(RuntimeError, match="diverged"):
-        Coupling(scene, Interrupting(dem, 300), p, tmp_path, progress_every=1e9).run()
-    dem.close()
+        simulate(scene, tmp_path, progress_every=1e9, wrap=lambda dem: Interrupting(dem, 300))
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["status"].startswith("stopped at t = 0.003 s by RuntimeError: diverged")
     rows = list(csv.DictReader(open(tmp_path / "collisions.csv")))

@@ -1,4 +1,4 @@
-"""SceneDem on the real LIGGGHTS: the fluid-force array starts at zero, however many engines
+"""The scene DEM on the real LIGGGHTS: the fluid-force array starts at zero, however many engines
 the process built before (the array is uninitialised memory until set).
 
 The engines are built in a fresh Python process: the bridge tries each command in a forked
@@ -19,20 +19,25 @@ SCRIPT = """
 import json, sys
 import numpy as np
 from pathlib import Path
-from pyhost.dem import FLUID_FIX, SceneDem
-from pyhost.dem_input import place_particles
+from pyhost.commands.run import box_world
+from pyhost.dem import FLUID_FIX, Dem
 from pyhost.scene import load_scene
+from pyhost.script import read_script
 scene = load_scene(sys.argv[1])
-particles = place_particles(scene)
 g, dt = np.array(scene.domain.gravity), scene.time.dem_step
 result = []
 for k in range(4):
-    dem = SceneDem(scene, particles, Path(sys.argv[2]) / f"dem{k}", fluid_force=True)
+    out = Path(sys.argv[2]) / f"run{k}"
+    script, _ = box_world(scene, out, True)
+    dem = Dem(out / "dem")
+    for cmd in read_script(script)[:-1]:
+        dem.command(cmd)
+    dem.prepare(heat=False, fluid_force=True)
     force = float(np.abs(dem.lmp.external_force(FLUID_FIX)).max())
-    v0 = dem.state()[1].copy()
+    v0 = dem.atoms(False).v.copy()
     dem.run(1)
-    result.append((force, float(np.abs(dem.state()[1] - v0 - g * dt).max())))
-    dem.close()
+    result.append((force, float(np.abs(dem.atoms(False).v - v0 - g * dt).max())))
+    dem.lmp.close()
 print(json.dumps(result))
 """
 

@@ -1,0 +1,249 @@
+"""A user's LIGGGHTS input script, read as LIGGGHTS reads it, so the host can run it command
+by command and turn each ``run N`` into N coupled steps.
+
+``read_script(path)`` gives the commands with their file and line: '#' comments dropped
+(outside quotes), '&' continuation lines joined, ``include FILE`` expanded in place (paths
+relative to the case folder, where the script runs). Commands that need LIGGGHTS' own
+input loop (``jump``, ``label``, ``next``) cannot be run one by one and are refused with
+their line. ``$`` variables are left to LIGGGHTS, which substitutes them when each command
+runs. The ``parse_*`` helpers read what the host must know about a command: the granular
+walls (geometry of a primitive wall, meshes of a mesh wall), contact computes, heat/gran.
+"""
+from __future__ import annotations
+
+import shlex
+from dataclasses import dataclass, field
+from pathlib import Path
+
+REFUSED = {
+    "jump": "loops and jumps need LIGGGHTS' own input loop",
+    "label": "loops and jumps need LIGGGHTS' own input loop",
+    "next": "loops and jumps need LIGGGHTS' own input loop",
+    "quit": "the host ends the run itself",
+    "shell": "the host does not run shell commands for a script",
+}
+
+# compute pair/gran/local and wall/gran/local: LIGGGHTS writes the keywords' groups in this
+# order whatever order they are typed in (compute_pair_gran_local.cpp, init_cpgl), heatFlux last.
+LOCAL_GROUPS = (("pos", 6), ("vel", 6), ("id", 3), ("force", 3), ("force_normal", 3),
+                ("force_tangential", 3), ("torque", 3), ("history", None), ("contactArea", 1),
+                ("delta", 1), ("heatFlux", 1))
+LOCAL_DEFAULT = ("pos", "vel", "id", "force", "torque", "history", "contactArea")
+
+
+class ScriptError(ValueError):
+    """A script the host cannot run, naming the file and the line."""
+
+
+@dataclass(frozen=True)
+class Command:
+    text: str
+    file: str
+    line: int
+
+    @property
+    def words(self) -> list[str]:
+        return shlex.split(self.text, posix=True) if self.text else []
+
+    @property
+    def name(self) -> str:
+        return self.text.split(None, 1)[0]
+
+    def where(self) -> str:
+        return f"{self.file}:{self.line}"
+
+
+def _strip_comment(line: str) -> str:
+    quote = None
+    for k, ch in enumerate(line):
+        if quote:
+            if ch == quote:
+                quote = None
+        elif ch in "\"'":
+            quote = ch
+        elif ch == "#":
+            return line[:k]
+    return line
+
+
+def read_script(path: str | Path, folder: str | Path | None = None, _depth: int = 0) -> list[Command]:
+    """The commands of a LIGGGHTS script (see the module doc). ``folder``: where relative
+    include paths are found (the case folder; default the script's own folder)."""
+    path = Path(path)
+    folder = Path(folder) if folder is not None else path.parent
+    if _depth > 20:
+        raise ScriptError(f"{path}: include nested more than 20 deep")
+    try:
+        raw = path.read_text().splitlines()
+    except FileNotFoundError:
+        raise ScriptError(f"{path}: no such LIGGGHTS script") from None
+    except UnicodeDecodeError as exc:
+        raise ScriptError(f"{path}: not a text file ({exc.reason} at byte {exc.start})") from None
+    commands, pending, first = [], "", 0
+    for number, line in enumerate(raw, start=1):
+        text = _strip_comment(line).rstrip()
+        if not pending:
+            first = number
+        if text.endswith("&"):
+            pending += text[:-1] + " "
+            continue
+        text = (pending + text).strip()
+        pending = ""
+        if not text:
+            continue
+        cmd = Command(" ".join(text.split()) if '"' not in text and "'" not in text else text, str(path), first)
+        if cmd.name in REFUSED:
+            raise ScriptError(f"{cmd.where()}: '{cmd.name}': {REFUSED[cmd.name]}; the host runs a script "
+                              "command by command (unroll the loop, or give the values as variables)")
+        if cmd.name == "include":
+            words = cmd.words
+            if len(words) != 2:
+                raise ScriptError(f"{cmd.where()}: include takes one file name")
+            if "$" in words[1]:
+                raise ScriptError(f"{cmd.where()}: include of a variable file name is not supported")
+            commands += read_script(folder / words[1], folder, _depth + 1)
+            continue
+        commands.append(cmd)
+    if pending:
+        raise ScriptError(f"{path}:{first}: the script ends inside a '&' continuation")
+    return commands
+
+
+@dataclass(frozen=True)
+class RunCommand:
+    """``run N [upto] [pre yes|no] [post yes|no]``: steps (possibly a $variable, evaluated by
+    the host through LIGGGHTS) and whether N is an end step."""
+
+    steps: str
+    upto: bool
+
+
+def parse_run(cmd: Command) -> RunCommand:
+    words = cmd.words
+    if len(words) < 2:
+        raise ScriptError(f"{cmd.where()}: 'run' needs a number of steps")
+    rest, upto = words[2:], False
+    while rest:
+        key = rest.pop(0)
+        if key == "upto":
+            upto = True
+        elif key in ("pre", "post") and rest:
+            rest.pop(0)
+        elif key in ("start", "stop") and rest:
+            rest.pop(0)
+        else:
+            raise ScriptError(f"{cmd.where()}: 'run ... {key}' is not supported by the host (supported: "
+                              "run N [upto] [pre yes|no] [post yes|no])")
+    return RunCommand(words[1], upto)
+
+
+@dataclass(frozen=True)
+class GranWall:
+    """A ``fix ID group wall/gran ...``: a primitive wall (``geometry`` = (kind, numbers),
+    kind xplane, yplane, zplane, xcylinder, ycylinder or zcylinder) or mesh walls
+    (``meshes``: ids of their fix mesh/surface)."""
+
+    fix: str
+    primitive: tuple | None = None
+    meshes: tuple = ()
+    type: int | None = None
+    moving: bool = False
+
+
+PRIMITIVES = {"xplane": 1, "yplane": 1, "zplane": 1, "xcylinder": 3, "ycylinder": 3, "zcylinder": 3}
+
+
+def parse_wall(cmd: Command) -> GranWall | None:
+    """The wall of a ``fix ... wall/gran`` command, or None if the command is not one."""
+    w = cmd.words
+    if len(w) < 4 or w[0] != "fix" or w[3] != "wall/gran":
+        return None
+    if "primitive" in w:
+        k = w.index("primitive")
+        try:
+            wall_type = int(w[w.index("type", k) + 1])
+            kind = next(x for x in w[k:] if x in PRIMITIVES)
+            at = w.index(kind, k)
+            numbers = tuple(float(x) for x in w[at + 1: at + 1 + PRIMITIVES[kind]])
+        except (ValueError, StopIteration, IndexError):
+            raise ScriptError(f"{cmd.where()}: primitive wall the host cannot read (supported: "
+                              f"{', '.join(PRIMITIVES)} with plain numbers)") from None
+        return GranWall(w[1], primitive=(kind, numbers), type=wall_type,
+                        moving=any(x in w for x in ("wiggle", "shear", "rotate")))
+    if "meshes" in w:
+        k = w.index("meshes")
+        n = int(w[w.index("n_meshes") + 1]) if "n_meshes" in w else 1
+        return GranWall(w[1], meshes=tuple(w[k + 1: k + 1 + n]))
+    raise ScriptError(f"{cmd.where()}: fix wall/gran with neither 'primitive' nor 'meshes'")
+
+
+def local_columns(keywords: list[str], total: int | None = None) -> dict:
+    """Column slices of a ``compute pair/gran/local`` (or wall/gran/local) with these keywords,
+    in LIGGGHTS' code order. ``history`` has as many columns as the pair style keeps; it is
+    found from ``total``, the compute's column count."""
+    keywords = list(keywords) or list(LOCAL_DEFAULT)
+    unknown = [k for k in keywords if k not in dict(LOCAL_GROUPS)]
+    if unknown:
+        raise ScriptError(f"unknown pair/gran/local keyword(s) {unknown}")
+    fixed = sum(n for k, n in LOCAL_GROUPS if k in keywords and n is not None)
+    cols, at = {}, 0
+    for key, n in LOCAL_GROUPS:
+        if key not in keywords:
+            continue
+        if n is None:
+            if total is None:
+                raise ScriptError("the column count of a compute with 'history' is needed to lay out its columns")
+            n = total - fixed
+        cols[key] = slice(at, at + n)
+        at += n
+    if total is not None and at != total:
+        raise ScriptError(f"a compute with keywords {' '.join(keywords)} has {at} columns, LIGGGHTS gave {total}")
+    return cols
+
+
+@dataclass
+class ScriptInfo:
+    """What the host learns from the commands run so far."""
+
+    walls: dict = field(default_factory=dict)           # fix id -> GranWall
+    mesh_types: dict = field(default_factory=dict)      # fix mesh/surface id -> atom type of the wall
+    pair_compute: tuple | None = None                   # (id, keywords) of compute pair/gran/local
+    wall_compute: tuple | None = None                   # (id, keywords) of compute wall/gran/local
+    heat_gran: str | None = None                        # id of fix heat/gran
+    temp_fix: bool = False                              # a fix property/atom Temp exists
+    pair_model: str = ""                                # the pair style's normal model
+    globals: dict = field(default_factory=dict)         # property/global name -> fix id
+    periodic: tuple = (False, False, False)             # from the boundary command
+
+    def wall_type(self, fix: str) -> int | None:
+        """The LIGGGHTS atom type of a wall fix (its primitive's, or its first mesh's)."""
+        wall = self.walls.get(fix)
+        if wall is None:
+            return None
+        return wall.type if wall.primitive is not None else self.mesh_types.get(wall.meshes[0] if wall.meshes else "")
+
+    def learn(self, cmd: Command) -> None:
+        w = cmd.words
+        if w[0] == "fix" and len(w) >= 4:
+            style = w[3]
+            if style == "wall/gran":
+                self.walls[w[1]] = parse_wall(cmd)
+            elif style.startswith("mesh/surface") and "type" in w:
+                self.mesh_types[w[1]] = int(w[w.index("type") + 1])
+            elif style == "heat/gran":
+                self.heat_gran = w[1]
+            elif style == "property/atom" and len(w) >= 5 and w[4] == "Temp":
+                self.temp_fix = True
+            elif style == "property/global" and len(w) >= 5:
+                self.globals[w[4]] = w[1]
+        elif w[0] == "unfix" and len(w) == 2:
+            self.walls.pop(w[1], None)
+            if self.heat_gran == w[1]:
+                self.heat_gran = None
+        elif w[0] == "compute" and len(w) >= 4 and w[3] in ("pair/gran/local", "wall/gran/local"):
+            which = "pair_compute" if w[3] == "pair/gran/local" else "wall_compute"
+            setattr(self, which, (w[1], w[4:]))
+        elif w[0] == "boundary" and len(w) >= 4:
+            self.periodic = tuple(b == "p" for b in w[1:4])
+        elif w[0] == "pair_style" and len(w) >= 4 and w[1] == "gran" and w[2] == "model":
+            self.pair_model = w[3]
