@@ -1,6 +1,6 @@
 """``python -m pyhost compare``: every collision heat model side by side (docs/comparison.md).
 
-(a) Q against impact speed for models A, B, C, hertz, softened and softened_corrected, for
+(a) Q against impact speed for models A, B, C and every comparison model, for
     the hot-cold bed's aluminium beads (R = 0.5 mm, dT = 1 K), the DEM at --dem-modulus;
 (b) softened/real against the DEM's Young's modulus from 1e6 Pa to the real one, for
     aluminium, steel and glass (R = 1 mm, v0 = --speed, DEM restitution 0.9, DEM Poisson
@@ -75,20 +75,22 @@ def run(args) -> int:
     for name, props in MATERIALS.items():
         E_dem = np.geomspace(1e6, props[1], 60)
         Q = {m: np.array([heat(m, material(name, E), 1e-3, args.speed)[0] for E in E_dem])
-             for m in ("softened", "softened_corrected")}
+             for m in ("softened", "softened_corrected", "zhou")}
         Q_A, Q_h = (heat(m, material(name, 1e7), 1e-3, args.speed)[0] for m in ("A", "hertz"))
         ratios[name] = (E_dem, Q, Q_A, Q_h)
         for E in TABLE_MODULI:
-            s, c = (heat(m, material(name, E), 1e-3, args.speed)[0] for m in ("softened", "softened_corrected"))
-            table.append((name, E, s / Q_A, s / Q_h, c / Q_A, c / Q_h))
+            s, c, z = (heat(m, material(name, E), 1e-3, args.speed)[0]
+                       for m in ("softened", "softened_corrected", "zhou"))
+            table.append((name, E, s / Q_A, s / Q_h, c / Q_A, c / Q_h, z / Q_A, z / Q_h))
     write_csv(args.out / "comparison_modulus.csv",
               {k: [row[n] for row in table] for n, k in enumerate(
-                  ("material", "E_dem", "softened/A", "softened/hertz", "corrected/A", "corrected/hertz"))})
+                  ("material", "E_dem", "softened/A", "softened/hertz", "corrected/A", "corrected/hertz",
+                   "zhou/A", "zhou/hertz"))})
     print(f"(b) softened/real at v0 = {args.speed:g} m/s, R = 1 mm, DEM restitution {DEM_RESTITUTION}")
     print(f"{'material':>10} {'E_DEM [Pa]':>10} {'softened/A':>11} {'softened/hertz':>15} "
-          f"{'corrected/A':>12} {'corrected/hertz':>16}")
+          f"{'corrected/A':>12} {'corrected/hertz':>16} {'zhou/A':>8} {'zhou/hertz':>11}")
     for name, E, *r in table:
-        print(f"{name:>10} {E:10.0e} " + " ".join(f"{x:>{w}.3g}" for x, w in zip(r, (11, 15, 12, 16))))
+        print(f"{name:>10} {E:10.0e} " + " ".join(f"{x:>{w}.3g}" for x, w in zip(r, (11, 15, 12, 16, 8, 11))))
 
     bed = None
     if (args.bed / "collisions.csv").is_file():
@@ -144,6 +146,7 @@ def plot(args, v, speed, ratios, bed) -> list[Path]:
         ax.plot(E_dem, Q["softened"] / Q_A, color=colour, label=f"{name}: softened / A")
         ax.plot(E_dem, Q["softened"] / Q_h, color=colour, ls="--", label=f"{name}: softened / hertz")
         ax.plot(E_dem, Q["softened_corrected"] / Q_A, color=colour, ls=":", label=f"{name}: corrected / A")
+        ax.plot(E_dem, Q["zhou"] / Q_A, color=colour, ls="-.", label=f"{name}: zhou / A")
     ax.axhline(1.0, color="k", lw=0.8)
     ax.set(xscale="log", yscale="log", xlabel="DEM Young's modulus [Pa]", ylabel="Q softened / Q real",
            title=f"head-on, R = 1 mm, $v_0$ = {args.speed:g} m/s, DEM e = {DEM_RESTITUTION}")

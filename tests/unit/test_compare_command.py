@@ -43,9 +43,11 @@ def test_compare_tables_and_bed_totals(tmp_path):
     rows = read(tmp_path / "out" / "comparison_modulus.csv")
     for name in ("aluminium", "steel", "glass"):
         lo, hi = (r for r in rows if r["material"] == name)
-        # softened Q ~ E_DEM^(-3/5), with the area correction ~ E_DEM^(-4/15) (overlap << R)
+        # softened Q ~ E_DEM^(-3/5), with the area correction ~ E_DEM^(-4/15), zhou ~ E_DEM^(-2/5)
+        # (overlap << R)
         assert float(lo["softened/A"]) / float(hi["softened/A"]) == pytest.approx(10**0.6, rel=0.02)
         assert float(lo["corrected/A"]) / float(hi["corrected/A"]) == pytest.approx(10 ** (4 / 15), rel=0.02)
+        assert float(lo["zhou/A"]) / float(hi["zhou/A"]) == pytest.approx(10**0.4, rel=0.02)   # E^(-3/5 + 1/5)
     glass = rows[-1]                   # glass stays elastic at 0.5 m/s: A is Hertz
     assert float(glass["softened/A"]) == pytest.approx(float(glass["softened/hertz"]), rel=1e-9)
     speed = read(tmp_path / "out" / "comparison_speed.csv")

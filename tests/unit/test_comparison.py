@@ -50,18 +50,30 @@ def lens_area(delta, R1, R2):
     return -math.pi / 4 * ((r - R1 - R2) * (r + R1 - R2) * (r - R1 + R2) * (r + R1 + R2)) / r**2
 
 
-def direct_heat(v0, pair, dem, correction):
-    """Integrate m* delta'' = -F (normal_model_hertz.h) with dQ/dt = h(delta) dT, to release."""
+def kratos_radius(delta, R1, R2):
+    """Kratos' ThermalSphericParticle::ComputeContactRadius at centre distance d."""
+    if math.isinf(R2):
+        return math.sqrt(R1**2 - (R1 - delta) ** 2)
+    d = R1 + R2 - delta
+    return math.sqrt(abs(R1**2 - ((R1**2 - R2**2 + d**2) / (2 * d)) ** 2))
+
+
+def direct_heat(v0, pair, dem, name):
+    """Integrate m* delta'' = -F (normal_model_hertz.h) with dQ/dt = h(delta) dT, to release:
+    heat/gran's h (softened, softened_corrected) or Kratos' 4 k_eff R_c with Zhou's R_c (zhou)."""
     beta = math.log(dem.restitution) / math.sqrt(math.log(dem.restitution) ** 2 + math.pi**2) \
         if dem.restitution < 1 else 0.0
     R, m = pair.Rstar, pair.mstar
     h = 4 * pair.k1 * pair.k2 / (pair.k1 + pair.k2)
-    ratio = (dem.Ystar / dem.Ystar_original) ** (2 / 3) if correction else 1.0
+    ratio = (dem.Ystar / dem.Ystar_original) ** (2 / 3) if name == "softened_corrected" else 1.0
+    zhou = (dem.Ystar / dem.Ystar_original) ** 0.2
 
     def rhs(t, y):
         d = max(y[0], 0.0)
         Sn = 2 * dem.Ystar * math.sqrt(R * d)
         F = 4 / 3 * dem.Ystar * math.sqrt(R * d) * d - 2 * math.sqrt(5 / 6) * beta * math.sqrt(Sn * m) * y[1]
+        if name == "zhou":
+            return [y[1], -F / m, h * kratos_radius(d, pair.R1, pair.R2) * zhou * pair.dT]
         return [y[1], -F / m, h * math.sqrt(lens_area(ratio * d, pair.R1, pair.R2)) * pair.dT]
 
     release = lambda t, y: y[0]
@@ -72,7 +84,7 @@ def direct_heat(v0, pair, dem, correction):
     return sol.y_events[0][0][2], sol.t_events[0][0]
 
 
-@pytest.mark.parametrize("name", ["softened", "softened_corrected"])
+@pytest.mark.parametrize("name", ["softened", "softened_corrected", "zhou"])
 @pytest.mark.parametrize("pair, dem", [
     (Pair(R1=2e-3, R2=2e-3, k1=20.0, k2=20.0, dT=100.0), DemPair(5e6, 0.9, 100e9)),
     (Pair(R1=1e-3, R2=3e-3, k1=200.0, k2=1.0, rho2=2500.0, dT=-30.0), DemPair(1e8, 0.5, 40e9)),
@@ -82,7 +94,7 @@ def test_softened_matches_direct_time_integration(name, pair, dem):
     v0 = np.array([0.05, 0.5, 5.0])
     out = COMPARISON[name].heat(v0, pair, dem)
     for k, v in enumerate(v0):
-        Q, t_c = direct_heat(v, pair, dem, name == "softened_corrected")
+        Q, t_c = direct_heat(v, pair, dem, name)
         assert out["t_coll"][k] == pytest.approx(t_c, rel=1e-7)
         assert out["Q"][k] == pytest.approx(Q, rel=1e-6)
 
