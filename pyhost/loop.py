@@ -31,6 +31,7 @@ from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys
                                temperature_difference)
 from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
 from pyhost.dem import Dem
+from pyhost.liggghts import LiggghtsError
 from pyhost.output import CsvLog, Progress, VtkSeries
 from pyhost.script import ScriptError, parse_run
 
@@ -88,12 +89,12 @@ class Coupling:
         self.steps = 0
         self.totals = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0,
                            heat_from_walls=0.0, capped=0, clipped=0, heat_gran_undone=0.0,
-                           inserted=0, departed=0, energy_in=0.0, energy_out=0.0)
+                           inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0)
         self.CT_by_id = np.zeros(0)      # m c T of each id at its last sample [J] (energy balance)
         self.seen = np.zeros(0, bool)
         self.warned = set()
         self.heat = self.effects["collision_heat"]
-        self.laws = self.dem_laws()
+        self.laws = {}
         if self.heat and dem.info.heat_gran:
             self.check_capacities()
         atoms = dem.atoms(self.heat)
@@ -118,6 +119,8 @@ class Coupling:
 
     def advance(self, n: int) -> None:
         """n coupled DEM steps: the loop of the module doc."""
+        if self.heat:
+            self.resync()
         while n > 0:
             step = self.dem.step - self.t0_step
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
@@ -136,6 +139,21 @@ class Coupling:
             if due["frame"]:
                 self.write_frame()
             self.progress.update(self.t, f", {self.totals['collisions']} collisions")
+        if self.heat:
+            self.track_particles(self.dem.atoms(True))
+
+    def resync(self) -> None:
+        """Before each run: heat content that the script's own commands changed since the last
+        run (e.g. ``set ... property/atom Temp``) enters the balance as set by the script."""
+        atoms = self.dem.atoms(True)
+        known = np.zeros(len(atoms.id), bool)
+        inside = atoms.id < len(self.seen)
+        known[inside] = self.seen[atoms.id[inside]]
+        if known.any():
+            C = atoms.mass[known] * self.capacity[self.materials_of(atoms.type[known])]
+            self.totals["energy_set_by_script"] += float(np.sum(C * atoms.T[known])
+                                                         - self.CT_by_id[atoms.id[known]].sum())
+        self.track_particles(atoms)
 
     # -- particles ----------------------------------------------------------------------
     def materials_of(self, types) -> np.ndarray:
@@ -190,18 +208,15 @@ class Coupling:
         if self.heat and self.dem.info.heat_gran and len(c):
             self.undo_heat_gran(atoms, c, keys)
 
-    def dem_laws(self) -> dict:
-        """The DEM's Hertz law for each pair of atom types, from the script's own values
-        (LIGGGHTS' effective modulus and per-pair restitution)."""
-        n = len(self.type_material) - 1
-        if not self.effects["contact_extraction"] or n < 1:
-            return {}
-        E = self.dem.type_values("youngsModulus", n)
-        nu = self.dem.type_values("poissonsRatio", n)
-        e = self.dem.type_pair_values("coefficientRestitution", n)
-        return {(a, b): DemHertz(1.0 / ((1 - nu[a - 1] ** 2) / E[a - 1] + (1 - nu[b - 1] ** 2) / E[b - 1]),
-                                 float(e[a - 1, b - 1]))
-                for a in range(1, n + 1) for b in range(1, n + 1)}
+    def dem_law(self, a: int, b: int) -> DemHertz:
+        """The DEM's Hertz law between atom types a and b, from the script's own values
+        (LIGGGHTS' effective modulus and per-pair restitution); read once per pair."""
+        if (a, b) not in self.laws:
+            E = [self.dem.lmp.fix_global(self.dem.info.globals["youngsModulus"], t - 1) for t in (a, b)]
+            nu = [self.dem.lmp.fix_global(self.dem.info.globals["poissonsRatio"], t - 1) for t in (a, b)]
+            e = self.dem.lmp.fix_global(self.dem.info.globals["coefficientRestitution"], a - 1, b - 1)
+            self.laws[a, b] = DemHertz(1.0 / ((1 - nu[0] ** 2) / E[0] + (1 - nu[1] ** 2) / E[1]), e)
+        return self.laws[a, b]
 
     def check_capacities(self) -> None:
         """A script's fix heat/gran integrates Temp with its own thermalCapacity: it must be the
@@ -243,7 +258,7 @@ class Coupling:
         if self.dem.info.pair_model == "hertz":
             for (a, b) in set(zip(ti.tolist(), tj.tolist())):
                 s = (ti == a) & (tj == b)
-                v0[s] = self.laws[a, b].impact_speed(delta[s], approach[s], R_eff[s], m_eff[s],
+                v0[s] = self.dem_law(a, b).impact_speed(delta[s], approach[s], R_eff[s], m_eff[s],
                                                      window=self.every["sample"] * self.dem.dt)
         elif "model" not in self.warned:
             self.warned.add("model")
@@ -380,8 +395,9 @@ class Coupling:
             self.track_particles(atoms)
             CT = float(np.sum(self.C * atoms.T))
             t = self.totals
-            summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=(
-                CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]) / self.CT0)
+            summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=(    # relative to all
+                CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]      # that came in
+                - t["energy_set_by_script"]) / max(self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"]), 1e-300))
         (self.out / "summary.json").write_text(json.dumps(summary, indent=1))
         self.collisions.close()
         self.history.close()
@@ -403,8 +419,11 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 continue
             run = parse_run(cmd)
             if coupling is None:
-                added = dem.prepare(heat=effects["collision_heat"], contacts=effects["contact_extraction"],
-                                    fluid_force=fluid is not None)
+                try:
+                    added = dem.prepare(heat=effects["collision_heat"], contacts=effects["contact_extraction"],
+                                        fluid_force=fluid is not None)
+                except LiggghtsError as exc:
+                    raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
                 log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, **particles)

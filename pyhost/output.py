@@ -78,6 +78,9 @@ class Progress:
         self.last = now
         wall = now - self.start
         rate = t / wall if wall > 0 else 0.0
+        if self.end == float("inf"):            # a script's runs: no end known in advance
+            print(f"t = {t:.5g} s, {rate:.3g} s simulated per s{extra}", file=self.stream, flush=True)
+            return
         left = (self.end - t) / rate if rate > 0 else float("inf")
         print(f"t = {t:.5g} / {self.end:.5g} s ({100 * t / self.end:5.1f} %), "
               f"{rate:.3g} s simulated per s, {left:.0f} s left{extra}", file=self.stream, flush=True)
