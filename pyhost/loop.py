@@ -27,8 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat
-from pyhost.contact_heat import evaluate, restitution_impulse
+from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
+                               temperature_difference)
+from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
 from pyhost.dem import Dem
 from pyhost.failures import particles_lost
 from pyhost.liggghts import LiggghtsError
@@ -106,7 +107,8 @@ class Coupling:
         self.track_particles(atoms)
         self.CT0 = self.totals.pop("energy_in")
         self.totals["energy_in"] = 0.0
-        self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS)
+        self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS
+                                 + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:]))
         self.history = CsvLog(self.out / "history.csv", ("time", "particles", "T_mean", "T_min", "T_max")
                               + tuple(f"T_group{k}" for k in range(len(self.group_names)))
                               + ("sum_mcT", "heat_from_walls", "energy_in", "energy_out", "collisions",
@@ -278,15 +280,23 @@ class Coupling:
             self.warned.add("model")
             print(f"warning: the DEM's normal model is '{self.dem.info.pair_model}', not hertz: impact speeds "
                   "are the approach speeds at the first sample in contact, not integrated back to touch")
-        model = self.scene.effects.contact_heat
+        models = self.scene.effects.heat_models
+        model = models[0] if models else "none"
         moved = e = t_coll = np.zeros(len(rows))
+        side = {}
         if self.heat:
-            G, e, t_coll = evaluate(model, self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0,
-                                    np.ones(len(rows)))                        # Q per kelvin [J/K]
+            args = (self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0, np.ones(len(rows)))
+            G, e, t_coll = evaluate(model, *args)                               # Q per kelvin [J/K]
+            if len(models) > 1:         # side columns: the same collisions at the same dT, nothing moved
+                dT = temperature_difference(atoms.T, i, jl, self.T_wall)
+                side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}
             moved, capped, from_walls = exchange_heat(atoms.T, self.C, i, jl, G, self.T_wall)
             self.totals["capped"] += capped
             self.totals["heat_from_walls"] += from_walls
             self.totals["heat_moved"] += float(np.abs(moved[~wall]).sum())
+            by_model = self.heat_by_model()
+            for m, q in zip(models, [moved] + list(side.values())):
+                by_model[m] += float(np.abs(q[~wall]).sum())
         normal = c.normal[rows]
         for k, key in enumerate(keys[rows]):
             self.open[int(key)] = (self.t, t_coll[k], e[k], v0[k], normal[k])
@@ -296,7 +306,12 @@ class Coupling:
         self.collisions.write_columns(time=np.full(len(rows), self.t), i=c.i[rows],
                                       j=np.where(wall, 0, c.j[rows]),
                                       wall=np.where(wall, c.j[rows] - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
-                                      t_coll=t_coll, model=np.full(len(rows), model))
+                                      t_coll=t_coll, model=np.full(len(rows), model), **side)
+
+    def heat_by_model(self) -> dict:
+        """Heat between particles [J], sum of |Q| over collisions, of each heat model: the one
+        that moved it and the side models on the same collisions."""
+        return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
 
     def end_collisions(self, atoms, closed) -> None:
         info = [self.open.pop(int(k)) for k in closed]
@@ -390,6 +405,7 @@ class Coupling:
 
     def finish(self, status: str = "completed") -> dict:
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
+        self.heat_by_model()
         summary = dict(self.totals, status=status, time=self.t, steps=self.steps, groups=self.group_names)
         if self.heat:
             atoms = self.dem.atoms(True)

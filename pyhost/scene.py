@@ -10,7 +10,8 @@ Example::
 
     [effects]
     fluid = false                 # OpenFOAM solver process
-    contact_heat = "A"            # none, A, B, C (plugins.heat models)
+    contact_heat = "A"            # none, A, B, C, or a comparison model (hertz, softened, ...);
+                                  # or a list: ["A", "B", "C", "softened"], the first moves heat
     heat_path = "fast"            # exact, fast
     restitution_feedback = false  # e(v0) of the model applied at contact end
     enduring_conduction = false   # conduction through contacts that outlast a collision
@@ -49,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from plugins.heat import MODELS
+from plugins.heat import MODEL_NAMES, MODELS
 
 
 class SceneError(ValueError):
@@ -66,6 +67,13 @@ def _check(value, rule: str) -> str | None:
         return f"must be in (0, 1], got {value!r}"
     if rule == "poisson" and not -1 < value < 0.5:
         return f"must be in (-1, 0.5), got {value!r}"
+    if rule == "models":
+        names = [value] if isinstance(value, str) else value
+        choices = ("none",) + MODEL_NAMES if isinstance(value, str) else MODEL_NAMES
+        if not names or not all(isinstance(n, str) and n in choices for n in names):
+            return f"must be one of {', '.join(choices)}, or a list of models, got {value!r}"
+        if len(set(names)) != len(names):
+            return f"names a model twice: {value!r}"
     if rule.startswith("in:") and value not in rule[3:].split(","):
         return f"must be one of {rule[3:].replace(',', ', ')}, got {value!r}"
     return None
@@ -81,12 +89,20 @@ def spec(rule: str = "", default=dataclasses.MISSING, doc: str = ""):
 @dataclass(frozen=True)
 class Effects:
     fluid: bool = spec(default=False, doc="run the OpenFOAM fluid solver")
-    contact_heat: str = spec("in:none," + ",".join(sorted(MODELS)), "none", "collision heat model")
+    contact_heat: str | list = spec("models", "none", "collision heat model, or a list of models: the first "
+                                    "moves the temperatures (and gives e), the others are side columns")
     heat_path: str = spec("in:exact,fast", "fast", "plugin evaluation path")
     restitution_feedback: bool = spec(default=False, doc="apply the model's e(v0) at contact end")
     enduring_conduction: bool = spec(default=False, doc="box scenes: LIGGGHTS' fix heat/gran conducts through "
                                                          "particle contacts that outlast a collision")
     wall_heat: bool = spec(default=True, doc="collisions with walls at a fixed temperature exchange heat")
+
+    @property
+    def heat_models(self) -> tuple:
+        """The collision heat models, the one that moves heat first; () for none."""
+        if isinstance(self.contact_heat, str):
+            return () if self.contact_heat == "none" else (self.contact_heat,)
+        return tuple(self.contact_heat)
 
 
 @dataclass(frozen=True)
@@ -215,7 +231,7 @@ class Scene:
 
     def effects_summary(self) -> dict:
         """What the host builds for this scene."""
-        heat = self.effects.contact_heat != "none"
+        heat = bool(self.effects.heat_models)
         return dict(
             fluid_solver=self.effects.fluid,
             contact_extraction=heat or self.effects.restitution_feedback,
@@ -248,7 +264,7 @@ def _build(cls, data, where: str, file: str):
         if kind is float and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         if not isinstance(value, kind) or (kind is not bool and isinstance(value, bool)):
-            raise SceneError(f"{file}: {key}: must be {kind.__name__}, got {value!r}")
+            raise SceneError(f"{file}: {key}: must be {getattr(kind, '__name__', str(kind))}, got {value!r}")
         if kind is float and not math.isfinite(value):
             raise SceneError(f"{file}: {key}: must be finite, got {value!r}")
         problem = _check(value, f.metadata.get("rule", "")) if f.metadata.get("rule") else None
@@ -343,8 +359,9 @@ def load_scene(path) -> Scene:
         if time.dem_step >= time.end:
             raise SceneError(f"{file}: time.dem_step: must be below time.end ({time.end}), got {time.dem_step}")
     fluid = _build(Fluid, data["fluid"], "fluid", file) if "fluid" in data else None
-    if effects.restitution_feedback and effects.contact_heat == "none":
-        raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model in effects.contact_heat")
+    if effects.restitution_feedback and (not effects.heat_models or effects.heat_models[0] not in MODELS):
+        raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model ({', '.join(sorted(MODELS))}) "
+                         f"first in effects.contact_heat; comparison models give no restitution")
     if effects.fluid and fluid is None:
         raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
     if fluid is not None and fluid.case:
