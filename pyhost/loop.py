@@ -119,7 +119,11 @@ class Coupling:
         self.every = dict(sample=scene.time.sample_every if self.effects["contact_extraction"] else 0,
                           frame=max(1, round(scene.output.every / dem.dt)),
                           couple=scene.time.couple_every if fluid is not None else 0)
-        if fluid is not None:
+
+    def start(self) -> None:
+        """The first fluid exchange and the first frame (after construction, so that an
+        interrupt from here on finds a coupling to write its summary)."""
+        if self.fluid is not None:
             self.couple_fluid()
         self.write_frame()
 
@@ -444,6 +448,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, **particles)
+                coupling.start()
                 max_steps = None if max_time is None else round(max_time / dem.dt)
             n = dem.steps(run.steps, run.upto)
             if max_steps is not None:
