@@ -30,6 +30,7 @@ import numpy as np
 from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
                                temperature_difference)
 from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
+from pyhost import signals
 from pyhost.dem import Dem
 from pyhost.failures import particles_lost
 from pyhost.liggghts import LiggghtsError
@@ -138,6 +139,7 @@ class Coupling:
                 a = self.dem.atoms(False)
                 self.before = (self.t, a.id.copy(), a.x.copy(), a.v.copy())
             self.dem.run(chunk)
+            signals.check()
             if self.keep_all is not None and self.dem.lmp.nlocal < len(self.before[1]):
                 self.lost()
             n -= chunk
