@@ -1,6 +1,10 @@
 """The ``softened`` comparison model against LIGGGHTS' own ``fix heat/gran``: two spheres in
 one head-on collision, the heat LIGGGHTS moved against the model's."""
+import json
 import math
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,7 +24,24 @@ T_HOT, T_COLD = 400.0, 300.0
 
 def liggghts_heat(workdir, area_correction: bool) -> tuple[float, int]:
     """Heat [J] LIGGGHTS moved from the hot sphere to the cold one over the collision, and
-    the number of steps in contact."""
+    the number of steps in contact. LIGGGHTS runs in a fresh process: its bridge tries
+    commands in forked copies, and a fork of a process where an earlier test started MPI can
+    hang in MPI."""
+    code = ("import json, sys; sys.path.insert(0, sys.argv[1]); import test_softened_heat as t; "
+            "print(json.dumps(t.run_liggghts(sys.argv[2], sys.argv[3] == '1')))")
+    r = subprocess.run([sys.executable, "-c", code, str(Path(__file__).parent), str(workdir),
+                        "1" if area_correction else "0"], capture_output=True, text=True, timeout=600,
+                       cwd=Path(__file__).resolve().parents[2])
+    assert r.returncode == 0, r.stderr[-3000:]
+    t1, t2, v_out, steps = json.loads(r.stdout.strip().splitlines()[-1])
+    m = RHO * 4 / 3 * math.pi * R**3
+    assert t1 + t2 == pytest.approx(T_HOT + T_COLD, abs=1e-9)
+    assert -v_out / V == pytest.approx(E_REST, rel=2e-3)      # the DEM's own restitution
+    return (T_HOT - t1) * m * C, steps
+
+
+def run_liggghts(workdir, area_correction: bool) -> list:
+    """The collision in LIGGGHTS: final temperatures [K], rebound speed [m/s], steps."""
     with Liggghts(workdir) as lg:
         lg.commands(granular_box((-0.01,) * 3, (0.01,) * 3, youngs=E_DEM, poisson=NU, restitution=E_REST,
                                  friction=0.5, skin=R / 2, dt=DT))
@@ -43,11 +64,7 @@ def liggghts_heat(workdir, area_correction: bool) -> tuple[float, int]:
             steps += 10
             assert steps < 200000
         t1, t2 = lg.temperature()
-        v_out = lg.atom("v")[0, 0]
-    m = RHO * 4 / 3 * math.pi * R**3
-    assert t1 + t2 == pytest.approx(T_HOT + T_COLD, abs=1e-9)
-    assert -v_out / V == pytest.approx(E_REST, rel=2e-3)      # the DEM's own restitution
-    return (T_HOT - t1) * m * C, steps
+        return [float(t1), float(t2), float(lg.atom("v")[0, 0]), steps]
 
 
 @pytest.mark.parametrize("name", ["softened", "softened_corrected"])
