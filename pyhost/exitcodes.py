@@ -19,7 +19,7 @@ class SimulationFailed(RuntimeError):
 def classify(exc: BaseException) -> tuple[int, str]:
     """Exit code and message for an exception that ended a command."""
     from pyhost.cli import UserError
-    from pyhost.openfoam import FluidError
+    from pyhost.engines.openfoam import FluidError
 
     if isinstance(exc, Interrupted):
         return exc.exit_code, f"interrupted: {exc}; the run stopped cleanly (see its summary.json)"

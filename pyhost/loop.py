@@ -31,9 +31,9 @@ from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys
                                temperature_difference)
 from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
 from pyhost import signals
-from pyhost.dem import Dem
+from pyhost.engines.dem import Dem
 from pyhost.failures import particles_lost
-from pyhost.liggghts import LiggghtsError
+from pyhost.engines.liggghts import LiggghtsError
 from pyhost.outdir import write_atomic
 from pyhost.output import CsvLog, Progress, VtkSeries
 from pyhost.script import ScriptError, parse_run
@@ -84,10 +84,7 @@ class Coupling:
         self.initial_T = initial_T
         self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
         self.before = None
-        self.walls = walls
-        self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
-        self.T_wall = np.array([w.temperature if self.effects["wall_heat"] else np.nan for w in walls])
-        self.wall_material = np.array([w.material for w in walls], int)
+        self.update_walls(walls)
         self.capacity = np.array([m.heat_capacity for m in self.materials])
         self.tracker = ContactTracker()
         self.open = {}                   # contact key -> (start time, model t_coll, e, v0, normal)
@@ -120,6 +117,13 @@ class Coupling:
         self.every = dict(sample=scene.time.sample_every if self.effects["contact_extraction"] else 0,
                           frame=max(1, round(scene.output.every / dem.dt)),
                           couple=scene.time.couple_every if fluid is not None else 0)
+
+    def update_walls(self, walls) -> None:
+        """The LIGGGHTS walls as the host sees them (a script may add walls between runs)."""
+        self.walls = walls
+        self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
+        self.T_wall = np.array([w.temperature if self.effects["wall_heat"] else np.nan for w in walls])
+        self.wall_material = np.array([w.material for w in walls], int)
 
     def start(self) -> None:
         """The first fluid exchange and the first frame (after construction, so that an
@@ -451,6 +455,8 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, **particles)
                 coupling.start()
+            else:
+                coupling.update_walls(walls_of(dem))
                 max_steps = None if max_time is None else round(max_time / dem.dt)
             n = dem.steps(run.steps, run.upto)
             if max_steps is not None:

@@ -2,7 +2,7 @@
 
 Inside ``stopping()`` each of them raises :class:`Interrupted` in the main thread, which
 unwinds like any error: the coupling loop writes summary.json with where and why it stopped,
-the engines are closed, the fluid solver (in its own session, see pyhost.openfoam) is ended,
+the engines are closed, the fluid solver (in its own session, see pyhost.engines.openfoam) is ended,
 and the command exits with 128 + the signal's number (130, 143, 129). A second signal during
 that clean-up is ignored, so the clean-up is not cut short.
 """

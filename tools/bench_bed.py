@@ -62,7 +62,7 @@ import numpy as np
 
 from pyhost.collisions import contact_keys
 from pyhost.commands.run import start_fluid
-from pyhost.dem import SceneDem
+from pyhost.engines.dem import SceneDem
 from pyhost.dem_input import place_particles
 from pyhost.loop import Coupling, layer_pressure_drop
 from pyhost.scene import load_scene

@@ -2,12 +2,12 @@
 
     .venv/bin/python tools/bench_engines.py [--particles 1000] [--repeat 200]
 
-Fluid (pyhost.openfoam.FluidSolver, named pipes):
+Fluid (pyhost.engines.openfoam.FluidSolver, named pipes):
   - exchange only: a request answered without fluid work (FIELDS) and the particle
     look-up (LOCATE: positions out; cell, U, grad p back), per coupling step;
   - a whole coupling step (look-up, drag, per-cell fields out, one fluid step) against the
     fluid step alone, serial and with mpirun -np 2.
-LIGGGHTS (pyhost.liggghts.Liggghts, in process):
+LIGGGHTS (pyhost.engines.liggghts.Liggghts, in process):
   - a run chunk (run N pre no post no), a contact list read, the forked trial of a command.
 """
 from __future__ import annotations
@@ -22,9 +22,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from pyhost.fluid_case import box_case  # noqa: E402
-from pyhost.liggghts import Liggghts, granular_box  # noqa: E402
-from pyhost.openfoam import FluidSolver  # noqa: E402
+from pyhost.engines.fluid_case import box_case  # noqa: E402
+from pyhost.engines.liggghts import Liggghts, granular_box  # noqa: E402
+from pyhost.engines.openfoam import FluidSolver  # noqa: E402
 
 
 def per_call(fn, repeat: int) -> float:

@@ -29,12 +29,12 @@ def resolved(scene) -> dict:
 
 
 def start_fluid(scene, folder: Path):
-    """The scene's fluid: a box case (pyhost.fluid_case) over the domain and the plenum below
+    """The scene's fluid: a box case (pyhost.engines.fluid_case) over the domain and the plenum below
     it, inlet at its z lo, outlet at z hi, solved by collheatFoam every time.couple_every DEM
     steps. The inlet value is the fluid velocity there, so the superficial velocity asked for
     needs a particle-free inlet (a plenum) to be met."""
-    from pyhost.fluid_case import box_case
-    from pyhost.openfoam import FluidSolver
+    from pyhost.engines.fluid_case import box_case
+    from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
     if f.case:                          # the user's own case, copied: the host never writes into it
@@ -99,6 +99,8 @@ def user_script(scene):
         type_material[m.types] = k
     T_material = np.array([m.temperature if m.temperature > 0 else np.nan for m in scene.materials.values()])
 
+    told = set()
+
     def walls_of(dem):
         known = dem.info.walls
         named = {}
@@ -108,12 +110,13 @@ def user_script(scene):
                                  f"before its first run; its walls: {', '.join(known) or 'none'}")
             named[w.fix] = (names.index(w.material), w.temperature if w.temperature > 0 else np.nan)
         for fix in known:
-            if fix not in named:
+            if fix not in named and fix not in told:
                 print(f"LIGGGHTS wall {fix!r} has no [[walls]] entry: adiabatic for collision heat")
         mesh = [f for f, w in known.items() if w.meshes]
-        if len(mesh) > 1:
+        if len(mesh) > 1 and not told.issuperset(known):
             print(f"warning: LIGGGHTS lists the contacts of one mesh wall fix only ({mesh[-1]!r}); "
                   f"collisions with {', '.join(mesh[:-1])} are not seen")
+        told.update(known)
         return [HostWall(f, *named.get(f, (-1, np.nan)), mesh=k)
                 for f, wall in known.items() for k in range(max(len(wall.meshes), 1))]
 
@@ -127,7 +130,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
     world, with the fluid if the scene has one. ``wrap(dem)`` may stand in front of the DEM
     (tests inject faults with it). Returns the summary."""
-    from pyhost.dem import Dem
+    from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
     from pyhost.loop import run_scene
     from pyhost.script import read_script

@@ -1,9 +1,9 @@
-"""Drag laws of pyhost.drag against their limits (pure functions, kept beside the engine
+"""Drag laws of plugins.drag against their limits (pure functions, kept beside the engine
 tests that use them)."""
 import numpy as np
 import pytest
 
-from pyhost import drag
+from plugins import drag
 
 pytestmark = pytest.mark.engines
 

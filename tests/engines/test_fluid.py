@@ -5,10 +5,10 @@ import pytest
 from foamlib import FoamCase
 from scipy.optimize import brentq
 
-from pyhost import drag
-from pyhost.fluid_case import box_case
-from pyhost.liggghts import Liggghts, granular_box
-from pyhost.openfoam import FluidError, FluidSolver
+from plugins import drag
+from pyhost.engines.fluid_case import box_case
+from pyhost.engines.liggghts import Liggghts, granular_box
+from pyhost.engines.openfoam import FluidError, FluidSolver
 
 pytestmark = pytest.mark.engines
 

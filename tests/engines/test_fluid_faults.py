@@ -6,8 +6,8 @@ import time
 
 import pytest
 
-from pyhost.fluid_case import box_case
-from pyhost.openfoam import FluidError, FluidSolver
+from pyhost.engines.fluid_case import box_case
+from pyhost.engines.openfoam import FluidError, FluidSolver
 
 pytestmark = pytest.mark.engines
 

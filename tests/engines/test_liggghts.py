@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyhost.liggghts import Liggghts, LiggghtsError, granular_box
+from pyhost.engines.liggghts import Liggghts, LiggghtsError, granular_box
 
 pytestmark = pytest.mark.engines
 
@@ -164,7 +164,7 @@ def test_bad_command_raises_with_liggghts_message_and_host_survives(tmp_path):
 def test_error_in_a_later_chunk_ends_the_process_with_liggghts_message(tmp_path):
     """Chunks after the first are not tried: LIGGGHTS' message still reaches stderr."""
     script = f"""
-from pyhost.liggghts import Liggghts, granular_box
+from pyhost.engines.liggghts import Liggghts, granular_box
 lg = Liggghts({str(tmp_path)!r})
 lg.commands(granular_box((-0.01,) * 3, (0.01,) * 3, youngs=5e6, poisson=0.3, restitution=1.0,
                          friction=0.5, skin=5e-4, dt=1e-5))

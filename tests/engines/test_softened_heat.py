@@ -12,7 +12,7 @@ import pytest
 from plugins.heat import Pair
 from plugins.heat.comparison import COMPARISON, DemPair
 from plugins.heat.pair import effective_modulus
-from pyhost.liggghts import Liggghts, granular_box
+from pyhost.engines.liggghts import Liggghts, granular_box
 
 pytestmark = pytest.mark.engines
 

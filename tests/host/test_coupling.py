@@ -38,7 +38,7 @@ REFERENCE = """
 import json, sys
 from pathlib import Path
 from pyhost.commands.run import box_world
-from pyhost.dem import Dem
+from pyhost.engines.dem import Dem
 from pyhost.scene import load_scene
 from pyhost.script import read_script
 case = Path(sys.argv[1])

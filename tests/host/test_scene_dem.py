@@ -20,7 +20,7 @@ import json, sys
 import numpy as np
 from pathlib import Path
 from pyhost.commands.run import box_world
-from pyhost.dem import FLUID_FIX, Dem
+from pyhost.engines.dem import FLUID_FIX, Dem
 from pyhost.scene import load_scene
 from pyhost.script import read_script
 scene = load_scene(sys.argv[1])

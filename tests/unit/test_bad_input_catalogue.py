@@ -169,7 +169,7 @@ def no_engine(monkeypatch):
     """Fail at once, rather than run an engine in this process, if a scene got through."""
     def started(*args, **kwargs):
         raise AssertionError("an engine was started")
-    monkeypatch.setattr("pyhost.dem.Dem", started)
+    monkeypatch.setattr("pyhost.engines.dem.Dem", started)
     monkeypatch.setattr("pyhost.commands.run.start_fluid", started)
 
 
@@ -355,7 +355,7 @@ def test_corrupt_table_cache_is_rebuilt_with_a_warning(tmp_path, monkeypatch):
 
 
 def test_fluid_mesh_rebuilt_when_its_inputs_change(tmp_path):
-    from pyhost.fluid_case import box_case
+    from pyhost.engines.fluid_case import box_case
     walls = {f: "wall" for f in ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")}
     make = lambda cells: box_case(tmp_path, lo=(0, 0, 0), hi=(1, 1, 1), cells=cells, boundaries=walls, rho=1.0, nu=1e-5)
     mesh = make((2, 2, 2)) / "constant" / "polyMesh"

@@ -8,9 +8,9 @@ import time
 
 import pytest
 
-from pyhost import openfoam
-from pyhost.fluid_case import box_case
-from pyhost.openfoam import FluidError, FluidSolver
+from pyhost.engines import openfoam
+from pyhost.engines.fluid_case import box_case
+from pyhost.engines.openfoam import FluidError, FluidSolver
 
 TIMEOUT = 1.0       # s, given to the host
 MARGIN = 2.0        # s, what the host may add (polling, killing, reaping)

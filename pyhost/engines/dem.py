@@ -1,4 +1,4 @@
-"""The DEM of a scene on the LIGGGHTS bridge (``pyhost.liggghts``): a LIGGGHTS script run
+"""The DEM of a scene on the LIGGGHTS bridge (``pyhost.engines.liggghts``): a LIGGGHTS script run
 command by command, either the user's own (``[dem] script``) or the box world the host
 generates from the scene (``pyhost.dem_input``). Both go through the same class.
 
@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from pyhost.collisions import WALL_BASE
-from pyhost.liggghts import Liggghts, LiggghtsError
+from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 
 FLUID_FIX = "collheat_fluid"
@@ -83,7 +83,7 @@ class Dem:
         self.prepared = False
         self.fluid_force = False
         self.pair_cols = self.wall_cols = None
-        self._last_x = None
+        self._warned_mesh = False
 
     # -- the script -----------------------------------------------------------------
     def command(self, cmd: Command) -> None:
@@ -190,7 +190,12 @@ class Dem:
             if wall.primitive is not None:
                 parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix, 0]))
         mesh_fixes = [f for f, w in self.info.walls.items() if w.meshes]
-        if mesh_fixes:
+        if mesh_fixes and self.info.wall_compute is None:
+            if not self._warned_mesh:
+                self._warned_mesh = True
+                self.log(f"warning: mesh wall fix {mesh_fixes[-1]!r} came after the first run, when LIGGGHTS no "
+                         "longer takes a compute wall/gran/local: its collisions are not seen")
+        elif mesh_fixes:
             fix = mesh_fixes[-1]
             codes = [WALL_BASE + wall_index[fix, k] for k in range(len(self.info.walls[fix].meshes))]
             parts.append(self._mesh_contacts(np.array(codes, np.int64)))

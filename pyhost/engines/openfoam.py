@@ -4,7 +4,7 @@ for a whole simulation and driven from Python.
 :class:`FluidSolver` starts the solver (serial, or ``mpirun -np N`` after ``decomposePar``),
 exchanges per-particle and per-cell data with each rank through two named pipes (see
 ``plugins/openfoam/collheatFoam/hostLink.H``), and turns the fluid seen by each particle into
-a force with a drag law chosen by name (:mod:`pyhost.drag`). Every exchange is checked: a
+a force with a drag law chosen by name (:mod:`plugins.drag`). Every exchange is checked: a
 solver that diverges or stops raises :class:`FluidError` carrying the tail of its log.
 
 Nothing waits on the solver for ever: every open, read and write of the pipes has a deadline
@@ -29,10 +29,10 @@ from pathlib import Path
 import numpy as np
 from foamlib import FoamFile
 
-from pyhost import drag as drag_laws
+from plugins import drag as drag_laws
 
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
-SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[1] / ".setup" / "bin" / "collheatFoam"))
+SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[2] / ".setup" / "bin" / "collheatFoam"))
 LOCATE, ADVANCE, FIELDS, WRITE, STOP = 1, 2, 3, 4, 5
 TIMEOUT = float(os.environ.get("COLLHEAT_FLUID_TIMEOUT", 120.0))   # s, see the module doc
 
@@ -88,7 +88,7 @@ class FluidSolver:
     ``case``: a case directory with a mesh (or a blockMeshDict), 0/U, 0/p and
     constant/transportProperties giving ``nu`` (m^2/s) and ``rho`` (kg/m^3).
     ``nprocs``: MPI ranks (>1 decomposes the case first; the case needs
-    system/decomposeParDict). ``drag``: name of a law in :mod:`pyhost.drag`.
+    system/decomposeParDict). ``drag``: name of a law in :mod:`plugins.drag`.
     ``alpha_min``: floor of the fluid volume fraction handed to the solver (-).
     ``timeout``: seconds the host waits for one answer of the solver.
 

@@ -1,0 +1,33 @@
+"""Fluid-particle drag laws, registered by name: one module per law, file name = key
+(the value of ``[fluid] drag``).
+
+Each law is a pure vectorised function
+
+    law(alpha, slip, d, rho, nu) -> K
+
+of the fluid volume fraction ``alpha`` around each particle (-), the magnitude of the slip
+velocity ``|u - v|`` between interstitial fluid and particle (m/s), the particle diameter
+``d`` (m), the fluid density ``rho`` (kg/m^3) and kinematic viscosity ``nu`` (m^2/s). It
+returns the drag coefficient of each particle ``K`` (kg/s): the drag force on the particle
+is ``K (u - v)`` (N), and the same force with the opposite sign acts on the fluid of its
+cell. For a volume-averaged momentum exchange coefficient beta (kg/m^3/s, Gidaspow's
+notation), ``K = beta V_p / (1 - alpha)``.
+
+The pressure-gradient (buoyancy) force ``-V_p grad p`` is not part of a law: the fluid
+solver is in "model A" form (Zhou, Kuang, Chu, Yu, J. Fluid Mech. 661 (2010) 482-510,
+set II) and the host adds it separately.
+"""
+from __future__ import annotations
+
+import importlib
+import pkgutil
+
+from plugins.heat.registry import lookup
+
+LAWS = {info.name: importlib.import_module(f"{__name__}.{info.name}").MODEL
+        for info in pkgutil.iter_modules(__path__) if not info.name.startswith("_")}
+
+
+def get(name: str):
+    """The law registered as ``name``; ValueError listing the choices otherwise."""
+    return lookup(LAWS, name, "drag law")
