@@ -230,7 +230,8 @@ class FluidSolver:
                        for i in range(3)], axis=1)
         self._alpha = alpha
         self._ksl = ksum / self.cell_volumes
-        self._us = np.divide(kv, ksum[:, None], out=np.zeros_like(kv), where=ksum[:, None] > 0)
+        self._us = np.divide(kv, ksum[:, None], out=np.zeros(kv.shape), where=ksum[:, None] > 0)   # float
+        # also with no particle yet (a script that inserts later): bincount of nothing is int
         return k[:, None] * slip - (vp * self.rho)[:, None] * gradp
 
     @_exchange
