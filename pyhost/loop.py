@@ -20,6 +20,7 @@ classified (collision, then enduring) is told in ``pyhost.collisions``.
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from dataclasses import dataclass
@@ -301,9 +302,8 @@ class Coupling:
             by_model = self.heat_by_model()
             for m, q in zip(models, [moved] + list(side.values())):
                 by_model[m] += float(np.abs(q[~wall]).sum())
-        normal = c.normal[rows]
-        for k, key in enumerate(keys[rows]):
-            self.open[int(key)] = (self.t, t_coll[k], e[k], v0[k], normal[k])
+        self.open.update(zip(keys[rows].tolist(), zip(itertools.repeat(self.t), t_coll.tolist(), e.tolist(),
+                                                     v0.tolist(), c.normal[rows].tolist())))
         self.totals["collisions"] += len(rows)
         self.totals["particle_wall"] += int(wall.sum())
         self.totals["particle_particle"] += int((~wall).sum())
@@ -318,7 +318,7 @@ class Coupling:
         return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
 
     def end_collisions(self, atoms, closed) -> None:
-        info = [self.open.pop(int(k)) for k in closed]
+        info = [self.open.pop(k) for k in closed.tolist()]
         if not self.scene.effects.restitution_feedback or not self.heat:
             return
         ids_i = (closed >> 31).astype(np.int64)
@@ -350,7 +350,7 @@ class Coupling:
         moved then is taken back: flux at this sample [W] times the part of the sample interval
         inside [start, start + t_coll] (exact when sampling every step)."""
         dt_s = self.every["sample"] * self.dem.dt
-        info = [self.open[int(k)] for k in keys]
+        info = [self.open[k] for k in keys.tolist()]
         start = np.array([inf[0] for inf in info])
         t_coll = np.array([inf[1] for inf in info])
         tau = np.clip(start + t_coll - (self.t - dt_s), 0.0, dt_s)
