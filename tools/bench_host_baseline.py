@@ -3,7 +3,7 @@ before the LIGGGHTS-script rewrite (commit a8d075d: ``SceneDem`` and ``Coupling(
 ``bench_host.py --baseline TREE`` runs it with PYTHONPATH=TREE; it prints the rows as one
 JSON line.
 
-Run: PYTHONPATH=/path/to/old/checkout .venv/bin/python tools/bench_host_baseline.py SIM_TIME N [N ...]
+Run: PYTHONPATH=/path/to/old/checkout .venv/bin/python tools/bench_host_baseline.py SIM_TIME REPEAT N [N ...]
 """
 from __future__ import annotations
 
@@ -20,9 +20,10 @@ from pyhost.loop import Coupling
 
 
 def run_host(scene, out: Path):
-    t = time.perf_counter()
+    """As bench_host.run_host: wall time of Coupling.run(), not of the DEM's set-up."""
     particles = place_particles(scene)
     dem = SceneDem(scene, particles, out / "dem")
+    t = time.perf_counter()
     try:
         summary = Coupling(scene, dem, particles, out, progress_every=1e9).run()
     finally:
@@ -32,5 +33,5 @@ def run_host(scene, out: Path):
 
 if __name__ == "__main__":
     with tempfile.TemporaryDirectory() as tmp:
-        rows = heat_by_size(run_host, [int(n) for n in sys.argv[2:]], float(sys.argv[1]), Path(tmp))
+        rows = heat_by_size(run_host, [int(n) for n in sys.argv[3:]], float(sys.argv[1]), Path(tmp), int(sys.argv[2]))
     print(json.dumps(rows))
