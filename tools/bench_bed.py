@@ -139,7 +139,8 @@ def run(scene, out: Path, particles=None, record: bool = False, nudge: float = 0
     final = None
     if probe:
         probe.count(out / "collisions.csv")
-        last = probe.snaps[-1]           # the run ends on a snapshot: its time is a multiple of STRIDE
+        last = probe.snaps[-1]           # the run ends on a snapshot: its time is a multiple of STRIDE;
+        # in particle order: box scenes keep LIGGGHTS' local order (atom_modify sort 0 0, one process)
         final = dataclasses.replace(particles_at_start, position=last["x"], velocity=last["v"])
     return wall, summary, probe, final
 
