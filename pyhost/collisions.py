@@ -15,8 +15,6 @@ time is counted twice.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from plugins.dem.hertz import DemHertz, restitution_beta  # noqa: F401  (re-exported for the host)
@@ -34,27 +32,33 @@ def contact_keys(i, j):
     return (lo << 31) | hi
 
 
-@dataclass
 class ContactTracker:
     """The open contacts between two samples of the contact list.
 
     ``update(keys)`` returns the indices (into keys) of contacts that opened since the last
-    sample and the keys of those that closed; the host stores per-contact data alongside.
+    sample and the keys of those that closed (in the order of the last sample); the host
+    stores per-contact data alongside. Membership by binary search in sorted copies.
     """
 
-    open_keys: np.ndarray = None
-
-    def __post_init__(self):
-        self.open_keys = np.empty(0, np.int64) if self.open_keys is None else self.open_keys
+    def __init__(self):
+        self.open_keys = np.empty(0, np.int64)
+        self._sorted = self.open_keys
 
     def update(self, keys: np.ndarray):
         keys = np.asarray(keys, np.int64)
-        if np.unique(keys).size != keys.size:
+        ordered = np.sort(keys)
+        if np.any(ordered[1:] == ordered[:-1]):
             raise ValueError("contact list holds the same contact twice (is newton off?)")
-        opened = np.flatnonzero(~np.isin(keys, self.open_keys))
-        closed = self.open_keys[~np.isin(self.open_keys, keys)]
-        self.open_keys = keys.copy()
+        opened = np.flatnonzero(~_member(keys, self._sorted))
+        closed = self.open_keys[~_member(self.open_keys, ordered)]
+        self.open_keys, self._sorted = keys.copy(), ordered
         return opened, closed
+
+
+def _member(values, ordered):
+    """Whether each value is in the sorted array ``ordered``."""
+    at = np.minimum(np.searchsorted(ordered, values), max(len(ordered) - 1, 0))
+    return ordered[at] == values if len(ordered) else np.zeros(len(values), bool)
 
 
 def temperature_difference(T, i, j, T_wall=None):
@@ -79,24 +83,36 @@ def exchange_heat(T, C, i, j, G, T_wall=None):
     heat than would equalise the two temperatures: a G above C_i C_j/(C_i + C_j) (C_i for a
     wall) is capped there. Returns the heat moved per collision [J], the number capped, and
     the heat that entered the particles from walls [J]; sum(C T) changes by exactly that.
+
+    Done in rounds, bit-identical to the loop: a round takes every remaining collision that is
+    the first remaining one of both its particles (a wall, of fixed temperature, is nobody's
+    state), so no particle appears twice in a round and each meets its partners in order.
     """
+    i, j, G = np.asarray(i), np.asarray(j), np.asarray(G, float)
+    wall = j >= WALL_BASE
+    tw = np.full(len(j), np.nan)
+    if wall.any() and T_wall is not None:
+        tw[wall] = np.asarray(T_wall, float)[j[wall] - WALL_BASE]
+    active = np.flatnonzero(~wall | ~np.isnan(tw))
+    limit = np.where(wall, C[i], C[i] * C[np.where(wall, i, j)] / (C[i] + C[np.where(wall, i, j)]))
+    capped = int(np.count_nonzero(G[active] > limit[active]))
+    g = np.minimum(G, limit)
     moved = np.zeros(len(G))
-    capped, from_walls = 0, 0.0
-    for k, (a, b, g) in enumerate(zip(np.asarray(i), np.asarray(j), np.asarray(G, float))):
-        if b >= WALL_BASE:
-            tw = np.nan if T_wall is None else T_wall[b - WALL_BASE]
-            if np.isnan(tw):
-                continue
-            limit, dT = C[a], T[a] - tw
-        else:
-            limit, dT = C[a] * C[b] / (C[a] + C[b]), T[a] - T[b]
-        if g > limit:
-            g, capped = limit, capped + 1
-        q = g * dT
+    # the second body of a wall collision: a code of its own that no particle shares
+    other = np.where(wall, -1 - np.arange(len(j)), j)
+    left = active
+    while len(left):
+        ends = np.stack([i[left], other[left]], axis=1).ravel()
+        first = np.zeros(len(ends), bool)
+        first[np.unique(ends, return_index=True)[1]] = True
+        now = first.reshape(-1, 2).all(axis=1)
+        k = left[now]
+        a, b, pair = i[k], j[k], ~wall[k]
+        q = g[k] * (T[a] - np.where(pair, T[np.where(pair, b, a)], tw[k]))
         T[a] -= q / C[a]
-        if b >= WALL_BASE:
-            from_walls -= q
-        else:
-            T[b] += q / C[b]
+        T[b[pair]] += q[pair] / C[b[pair]]
         moved[k] = q
+        left = left[~now]
+    q_walls = moved[active[wall[active]]]
+    from_walls = 0.0 - float(np.cumsum(q_walls)[-1]) if len(q_walls) else 0.0   # summed in order
     return moved, capped, from_walls

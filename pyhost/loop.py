@@ -20,6 +20,7 @@ classified (collision, then enduring) is told in ``pyhost.collisions``.
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from dataclasses import dataclass
@@ -71,11 +72,13 @@ class Coupling:
     ``groups``: (names, function atoms -> group index per atom) for the history columns;
     ``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
     ``initial_T``: function (atoms, mask of new atoms) -> their starting temperature [K]
-    (NaN: keep the value LIGGGHTS holds).
+    (NaN: keep the value LIGGGHTS holds); ``contacts_open``: the contacts present at the start
+    (a restart from a settled state) are not collisions: open and enduring from the start.
     """
 
     def __init__(self, scene, dem: Dem, out: Path, *, type_material, groups, walls, initial_T, fluid=None,
-                 end: float | None = None, progress_every: float = 5.0, keep_all: np.ndarray | None = None):
+                 end: float | None = None, progress_every: float = 5.0, keep_all: np.ndarray | None = None,
+                 contacts_open: bool = False):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
         self.materials = list(scene.materials.values())
@@ -83,6 +86,7 @@ class Coupling:
         self.group_names, self.group_of = groups
         self.initial_T = initial_T
         self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
+        self.contacts_open = contacts_open
         self.before = None
         self.update_walls(walls)
         self.capacity = np.array([m.heat_capacity for m in self.materials])
@@ -128,6 +132,8 @@ class Coupling:
     def start(self) -> None:
         """The first fluid exchange and the first frame (after construction, so that an
         interrupt from here on finds a coupling to write its summary)."""
+        if self.contacts_open and self.every["sample"]:
+            self.open_present()
         if self.fluid is not None:
             self.couple_fluid()
         self.write_frame()
@@ -234,6 +240,16 @@ class Coupling:
         if self.heat and self.dem.info.heat_gran and len(c):
             self.undo_heat_gran(atoms, c, keys)
 
+    def open_present(self) -> None:
+        """The contacts present now count as open, enduring (t_coll 0: no collision time to
+        account for), with no restitution to impose at their end (e NaN)."""
+        c = self.dem.contacts(self.dem.atoms(self.heat), self.wall_index)
+        keys = contact_keys(c.i, c.j)
+        self.tracker.update(keys)
+        self.open.update(zip(keys.tolist(), zip(itertools.repeat(self.t), itertools.repeat(0.0),
+                                                itertools.repeat(math.nan), itertools.repeat(math.nan),
+                                                c.normal.tolist())))
+
     def dem_law(self, a: int, b: int) -> DemHertz:
         """The DEM's Hertz law between atom types a and b, from the script's own values
         (LIGGGHTS' effective modulus and per-pair restitution); read once per pair."""
@@ -307,9 +323,8 @@ class Coupling:
             by_model = self.heat_by_model()
             for m, q in zip(models, [moved] + list(side.values())):
                 by_model[m] += float(np.abs(q[~wall]).sum())
-        normal = c.normal[rows]
-        for k, key in enumerate(keys[rows]):
-            self.open[int(key)] = (self.t, t_coll[k], e[k], v0[k], normal[k])
+        self.open.update(zip(keys[rows].tolist(), zip(itertools.repeat(self.t), t_coll.tolist(), e.tolist(),
+                                                     v0.tolist(), c.normal[rows].tolist())))
         self.totals["collisions"] += len(rows)
         self.totals["particle_wall"] += int(wall.sum())
         self.totals["particle_particle"] += int((~wall).sum())
@@ -324,13 +339,14 @@ class Coupling:
         return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
 
     def end_collisions(self, atoms, closed) -> None:
-        info = [self.open.pop(int(k)) for k in closed]
+        info = [self.open.pop(k) for k in closed.tolist()]
         if not self.scene.effects.restitution_feedback or not self.heat:
             return
         ids_i = (closed >> 31).astype(np.int64)
         ids_j = (closed & ((1 << 31) - 1)).astype(np.int64)
         i = atoms.index(ids_i)
-        here = i >= 0
+        e = np.array([inf[2] for inf in info])
+        here = (i >= 0) & ~np.isnan(e)         # contacts there at a restart: no collision
         wall, jl, _, _, _, m_j = self.partners(atoms, np.maximum(i, 0), ids_j)
         here &= wall | (jl >= 0)
         normal = np.array([inf[4] for inf in info]).reshape(-1, 3)
@@ -339,7 +355,6 @@ class Coupling:
         lo, hi, periodic = self.dem.box()
         d = np.where(periodic, d - (hi - lo) * np.round(d / (hi - lo)), d)
         normal[~wall] = d[~wall] / np.linalg.norm(d[~wall], axis=1)[:, None]
-        e = np.array([inf[2] for inf in info])
         v0 = np.array([inf[3] for inf in info])
         v_j = np.where(wall[:, None], 0.0, atoms.v[jj])
         dv_i, dv_j, clipped = restitution_impulse(atoms.v[np.maximum(i, 0)], v_j, atoms.mass[np.maximum(i, 0)],
@@ -356,7 +371,7 @@ class Coupling:
         moved then is taken back: flux at this sample [W] times the part of the sample interval
         inside [start, start + t_coll] (exact when sampling every step)."""
         dt_s = self.every["sample"] * self.dem.dt
-        info = [self.open[int(k)] for k in keys]
+        info = [self.open[k] for k in keys.tolist()]
         start = np.array([inf[0] for inf in info])
         t_coll = np.array([inf[1] for inf in info])
         tau = np.clip(start + t_coll - (self.t - dt_s), 0.0, dt_s)

@@ -1,7 +1,8 @@
 """Benchmarks of the coupled fluidized bed (cases/hot-cold-bed: 3000 beads, collheatFoam).
 
-Wall time counts ``Coupling.run()`` only, not starting the engines (fluid mesh and solver
-launch, LIGGGHTS input: about 1 s per run), minus the benchmark's own recording.
+Wall time counts the coupled run from its first DEM step, not starting the engines (fluid
+mesh and solver launch, LIGGGHTS and its input: about 1 s per run), minus the benchmark's
+own recording.
 
 1. What each effect costs, from the case's initial placement (a loose jittered lattice
    that the fluid carries only in part: it settles during the first tens of ms, with fewer
@@ -18,9 +19,9 @@ launch, LIGGGHTS input: about 1 s per run), minus the benchmark's own recording.
    for ``--time`` and is compared with the smallest interval (``--reference``, default every
    DEM step) from the same state: (a) the initial placement, (b) the bubbling bed after
    ``--start`` of bed time (the shipped case run isothermally up to then; every run then
-   restarts from those positions and velocities, with spins, contact histories and the
-   fluid reset: a fresh fluid at rest, as at t = 0; the contacts present at the restart
-   count as open, not as collisions). Metrics, at ``--compare`` after the
+   restarts from those positions and velocities (``simulate(..., start=particles)``), with
+   spins, contact histories and the fluid reset: a fresh fluid at rest, as at t = 0; the
+   contacts present at the restart count as open, not as collisions). Metrics, at ``--compare`` after the
    start (a few ms: before chaos has decorrelated the runs):
    - dv/v: RMS over particles of |v - v_ref| over the RMS of |v_ref|: how far the
      particle motions have moved apart. A granular flow is chaotic: any difference grows,
@@ -60,11 +61,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.collisions import contact_keys
-from pyhost.commands.run import start_fluid
-from pyhost.engines.dem import SceneDem
+from bench_host import Clocked
+from pyhost.commands.run import simulate, start_fluid
 from pyhost.dem_input import place_particles
-from pyhost.loop import Coupling, layer_pressure_drop
+from pyhost.loop import layer_pressure_drop
 from pyhost.scene import load_scene
 
 CASE = Path(__file__).resolve().parents[1] / "cases" / "hot-cold-bed" / "case.toml"
@@ -82,11 +82,11 @@ def variant(scene, end, couple_every=None, **effects):
 class Probe:
     """The started fluid as the loop sees it, recording at every coupling the fluid's total
     force on the particles and the pressure drop over the mesh, and every ``snap``-th
-    coupling (and once more by :meth:`finish` after the run) the particle velocities, heat
-    moved and collisions so far. ``overhead``: seconds spent recording."""
+    coupling the particle positions and velocities; ``count`` adds the collisions and heat
+    moved so far to each snapshot after the run. ``overhead``: seconds spent recording."""
 
     def __init__(self, fluid, snap: int, dt: float):
-        self.fluid, self.snap, self.dt, self.coupling = fluid, snap, dt, None
+        self.fluid, self.snap, self.dt = fluid, snap, dt
         self.F, self.dp, self.snaps, self.overhead = [], [], [], 0.0
 
     def __getattr__(self, name):
@@ -94,70 +94,54 @@ class Probe:
 
     def couple(self, x, v, d, duration: float, steps: int = 1) -> np.ndarray:
         forces = self.fluid.particle_forces(x, v, d)
-        self.store(v, forces)
-        self.fluid.advance(duration, steps)
-        return forces
-
-    def finish(self, x, v, d) -> None:
-        self.store(v, self.fluid.particle_forces(x, v, d), snap=True)
-
-    def store(self, v, forces, snap: bool = False) -> None:
         t0 = time.perf_counter()
-        if snap or len(self.F) % self.snap == 0:
-            totals = self.coupling.totals
-            self.snaps.append({"t": len(self.F) * self.dt, "v": np.array(v, copy=True),
-                               "N": totals["collisions"], "Q": totals["heat_moved"]})
+        if len(self.F) % self.snap == 0:
+            self.snaps.append({"t": len(self.F) * self.dt, "x": np.array(x, copy=True), "v": np.array(v, copy=True)})
         self.F.append(forces[:, 2].sum())
         self.dp.append(layer_pressure_drop(self.fluid))
         self.overhead += time.perf_counter() - t0
+        self.fluid.advance(duration, steps)
+        return forces
+
+    def count(self, collisions_csv: Path) -> None:
+        """N: collisions, Q: heat moved between particles [J] (sum of |Q|) up to each snapshot."""
+        c = np.genfromtxt(collisions_csv, delimiter=",", names=True, usecols=("time", "wall", "Q"), ndmin=1)
+        for s in self.snaps:
+            upto = c["time"] <= s["t"] * (1 + 1e-9)
+            s["N"] = int(upto.sum())
+            s["Q"] = float(np.abs(c["Q"][upto & (c["wall"] == 0)]).sum())
 
 
-def open_contacts(coupling) -> None:
-    """Register the contacts of a restarted bed as open before the run: they are not
-    collisions of the run. Otherwise the first sample takes every contact of the packed bed
-    for an impact, reconstructs its impact speed (a slow path) and counts it."""
-    x, v = coupling.dem.state()
-    c = coupling.contacts(x, v)
-    keys = contact_keys(c.i, c.j)
-    coupling.tracker.update(keys)
-    coupling.open.update({int(key): (0.0, 0.0, 0.0, 0.0) for key in keys})   # start, t_coll, e, v0
-
-
-def run(scene, out: Path, particles=None, fluid_on: bool = True, record: bool = False, nudge: float = 0.0):
+def run(scene, out: Path, particles=None, record: bool = False, nudge: float = 0.0):
     """Run ``scene`` from ``particles`` (default: its initial placement, else a restart),
-    every position moved by up to ``nudge`` [m]. Returns the wall time of Coupling.run()
+    every position moved by up to ``nudge`` [m]. Returns the wall time of the coupled run
     (less recording), its summary, the probe (``record``, fluid runs) and the particles at
-    the end."""
-    restart = particles is not None
-    particles = particles if restart else place_particles(scene)
+    the end (``record``)."""
+    particles_at_start = particles if particles is not None else place_particles(scene)
     if nudge:
-        moved = np.random.default_rng(1).uniform(-nudge, nudge, particles.position.shape)
-        particles = dataclasses.replace(particles, position=particles.position + moved)
-    fluid = start_fluid(scene, out / "fluid") if fluid_on else None
-    probe = None
-    try:
-        dem = SceneDem(scene, particles, out / "dem", fluid_force=fluid_on)
-        try:
-            if fluid_on and record:
-                k = scene.time.couple_every
-                probe = Probe(fluid, STRIDE // k, k * scene.time.dem_step)
-            coupling = Coupling(scene, dem, particles, out, progress_every=1e9, fluid=probe or fluid)
-            if probe:
-                probe.coupling = coupling
-            if restart and coupling.effects["contact_extraction"]:
-                open_contacts(coupling)
-            t = time.perf_counter()
-            summary = coupling.run()
-            wall = time.perf_counter() - t - (probe.overhead if probe else 0.0)
-            x, v = dem.state()
-            if probe:
-                probe.finish(x, v, 2.0 * particles.radius)
-            final = dataclasses.replace(particles, position=x.copy(), velocity=v.copy())
-        finally:
-            dem.close()
-    finally:
-        if fluid is not None:
-            fluid.stop()
+        moved = np.random.default_rng(1).uniform(-nudge, nudge, particles_at_start.position.shape)
+        particles = dataclasses.replace(particles_at_start, position=particles_at_start.position + moved)
+    k = scene.time.couple_every
+    engines = {}
+
+    def wrap(dem):
+        engines["dem"] = Clocked(dem)
+        return engines["dem"]
+
+    def wrap_fluid(fluid):
+        engines["fluid"] = Probe(fluid, STRIDE // k, k * scene.time.dem_step)
+        return engines["fluid"]
+
+    summary = simulate(scene, out.resolve(), progress_every=1e9, wrap=wrap, start=particles,
+                       wrap_fluid=wrap_fluid if record else None)
+    probe = engines.get("fluid")
+    wall = time.perf_counter() - engines["dem"].started - (probe.overhead if probe else 0.0)
+    final = None
+    if probe:
+        probe.count(out / "collisions.csv")
+        last = probe.snaps[-1]           # the run ends on a snapshot: its time is a multiple of STRIDE;
+        # in particle order: box scenes keep LIGGGHTS' local order (atom_modify sort 0 0, one process)
+        final = dataclasses.replace(particles_at_start, position=last["x"], velocity=last["v"])
     return wall, summary, probe, final
 
 
@@ -260,17 +244,15 @@ def main() -> None:
         print(f"\n1. cost of each effect, from the initial placement (contacts sampled every "
               f"{base.time.sample_every} steps, fluid coupled every {base.time.couple_every}; best of {args.repeat})")
         print(f"{'effects':>40} | {'wall s per simulated s':>22} | collisions")
-        rows = (("plain DEM, no fluid (isothermal)", False, {"fluid": False, "contact_heat": "none"}),
-                ("fluid only (isothermal)", True, {"contact_heat": "none"}),
-                ("fluid + heat A, fast path (shipped)", True, {"contact_heat": "A", "heat_path": "fast"}),
-                ("fluid + heat A, exact path", True, {"contact_heat": "A", "heat_path": "exact"}),
-                ("+ restitution feedback", True, {"contact_heat": "A", "heat_path": "fast",
-                                                  "restitution_feedback": True}),
-                ("+ enduring conduction", True, {"contact_heat": "A", "heat_path": "fast",
-                                                 "restitution_feedback": True, "enduring_conduction": True}))
-        for k, (name, fluid_on, eff) in enumerate(rows):
-            runs = [run(variant(base, end, **eff), tmp / f"effects{k}-{r}", fluid_on=fluid_on)
-                    for r in range(args.repeat)]
+        rows = (("plain DEM, no fluid (isothermal)", {"fluid": False, "contact_heat": "none"}),
+                ("fluid only (isothermal)", {"contact_heat": "none"}),
+                ("fluid + heat A, fast path (shipped)", {"contact_heat": "A", "heat_path": "fast"}),
+                ("fluid + heat A, exact path", {"contact_heat": "A", "heat_path": "exact"}),
+                ("+ restitution feedback", {"contact_heat": "A", "heat_path": "fast", "restitution_feedback": True}),
+                ("+ enduring conduction", {"contact_heat": "A", "heat_path": "fast",
+                                           "restitution_feedback": True, "enduring_conduction": True}))
+        for k, (name, eff) in enumerate(rows):
+            runs = [run(variant(base, end, **eff), tmp / f"effects{k}-{r}") for r in range(args.repeat)]
             wall = min(r[0] for r in runs)
             count = runs[0][1]["collisions"] if eff["contact_heat"] != "none" else "-"
             print(f"{name:>40} | {wall / end:22.0f} | {count}", flush=True)
@@ -280,7 +262,7 @@ def main() -> None:
         if args.start > 0:
             t0 = max(1, round(args.start / (STRIDE * dt))) * STRIDE * dt
             print(f"\n2b. the same from the bed at t = {t0:g} s (isothermal, coupled every {base.time.couple_every})")
-            wall, _, _, developed = run(variant(base, t0, contact_heat="none"), tmp / "prelude")
+            wall, _, _, developed = run(variant(base, t0, contact_heat="none"), tmp / "prelude", record=True)
             print(f"(reaching it took {wall:.0f} s; RMS |v| there {rms(developed.velocity):.3g} m/s)")
             interval_table(base, end, compare, args.reference, weight, tmp / "b", developed)
     print(f"\nbenchmark run time {time.perf_counter() - started:.0f} s")

@@ -1,4 +1,6 @@
 """Benchmarks of the coupled host on a dry scene (cases/hot-cold-box, 1000 particles).
+Wall times count the coupled run from its first DEM step (not starting LIGGGHTS and running
+the script's set-up commands), except in section 2.
 
 1. What each effect costs: wall time per simulated second with the plain DEM, collision
    heat (fast and exact paths), restitution feedback and enduring conduction.
@@ -7,23 +9,31 @@
 3. What the sampling interval costs in accuracy: impact speeds and total heat against
    sampling every DEM step (median and 90th percentile of the per-collision error of v0,
    error of the total heat moved, collisions missed).
+4. Heat against plain DEM by size: the scene grown to N particles at the same packing, wall
+   time per DEM step without heat and with heat A (fast path), their ratio, and the cost
+   per collision (extra wall time / collisions); with ``--baseline TREE`` the same on the
+   code of another checkout (``tools/bench_host_baseline.py`` run with PYTHONPATH=TREE),
+   so that before and after come from one run.
 
-Run: .venv/bin/python tools/bench_host.py [--time 0.01]
+Run: .venv/bin/python tools/bench_host.py [--time 0.01] [--sections 1 2 3 4]
+     [--particles 1000 8000 27000] [--size-time 0.002] [--repeat 1] [--baseline /path/to/old/checkout]
 """
 from __future__ import annotations
 
 import argparse
 import csv
 import dataclasses
+import json
+import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from pyhost.commands.run import simulate
 from pyhost.dem_input import input_lines, place_particles, write_data
 from pyhost.scene import load_scene
 
@@ -37,10 +47,77 @@ def variant(scene, end, **effects):
         output=dataclasses.replace(scene.output, vtk=False, pictures=False, every=end))
 
 
-def run_host(scene, out: Path):
+def scaled(scene, n: int):
+    """The scene with n particles at its packing: box and regions grown about the box's low
+    corner by (n / N)^(1/3), each group's count by n / N; periodicity as it is."""
+    total = sum(g.count for g in scene.particles)
+    k = (n / total) ** (1 / 3)
+    lo = scene.domain.box[0::2]
+
+    def grow(b):
+        return [lo[a // 2] + (v - lo[a // 2]) * k for a, v in enumerate(b)]
+
+    groups = [dataclasses.replace(g, count=round(g.count * n / total), region=grow(g.region)) for g in scene.particles]
+    return dataclasses.replace(scene, particles=groups, domain=dataclasses.replace(scene.domain, box=grow(scene.domain.box)))
+
+
+def heat_by_size(run_host, sizes, sim_time: float, tmp: Path, repeat: int = 1) -> list[dict]:
+    """For each size: wall time per DEM step [s] plain and with heat A (fast), best of
+    ``repeat`` runs of each taken in turns, and the collisions. A short run of each first, so
+    that no row pays for loading libraries."""
+    base = load_scene(CASE)
+    for heat in ("none", "A"):
+        run_host(variant(base, 10 * base.time.dem_step, contact_heat=heat), tmp / f"warm-{heat}")
+    rows = []
+    for n in sizes:
+        sc = scaled(base, n)
+        steps = round(sim_time / sc.time.dem_step)
+        walls = {"none": [], "A": []}
+        for r in range(repeat):
+            for heat in walls:
+                wall, summary = run_host(variant(sc, sim_time, contact_heat=heat, heat_path="fast"),
+                                         tmp / f"{heat}{n}-{r}")
+                walls[heat].append(wall)
+        rows.append(dict(particles=sum(g.count for g in sc.particles), steps=steps, plain=min(walls["none"]) / steps,
+                         heat=min(walls["A"]) / steps, collisions=summary["collisions"]))
+    return rows
+
+
+def size_table(rows: list[dict], label: str) -> None:
+    for r in rows:
+        extra = (r["heat"] - r["plain"]) * r["steps"]
+        print(f"{label:>8} | {r['particles']:>9} | {1e3 * r['plain']:11.3f} | {1e3 * r['heat']:11.3f} | "
+              f"{r['heat'] / r['plain']:5.2f} | {r['collisions']:>10} | {1e6 * extra / max(r['collisions'], 1):8.1f}")
+
+
+class Clocked:
+    """The DEM as the loop sees it, noting when it first steps."""
+
+    def __init__(self, dem):
+        self.dem, self.started = dem, None
+
+    def __getattr__(self, name):
+        return getattr(self.dem, name)
+
+    def run(self, steps: int) -> None:
+        self.started = self.started or time.perf_counter()
+        self.dem.run(steps)
+
+
+def run_host(scene, out: Path, whole: bool = False):
+    """Wall time [s] of the coupled run from its first DEM step to its summary (``whole``:
+    with the engines' set-up), and the summary."""
+    from pyhost.commands.run import simulate         # here: bench_host_baseline imports this file
+
+    clocked = {}
+
+    def wrap(dem):
+        clocked["dem"] = Clocked(dem)
+        return clocked["dem"]
+
     t = time.perf_counter()
-    summary = simulate(scene, out.resolve(), progress_every=1e9)
-    return time.perf_counter() - t, summary
+    summary = simulate(scene, out.resolve(), progress_every=1e9, wrap=wrap)
+    return time.perf_counter() - (t if whole else clocked["dem"].started), summary
 
 
 def run_native(scene, out: Path) -> float:
@@ -79,7 +156,13 @@ def matched_errors(ref: dict, got: dict, window: float):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--time", type=float, default=0.01, help="simulated time per run [s]")
+    ap.add_argument("--time", type=float, default=0.01, help="simulated time per run of sections 1-3 [s]")
+    ap.add_argument("--sections", type=int, nargs="+", default=[1, 2, 3, 4], choices=[1, 2, 3, 4])
+    ap.add_argument("--particles", type=int, nargs="+", default=[1000, 8000, 27000], metavar="N",
+                    help="section 4: particle counts (the scene grown at its packing)")
+    ap.add_argument("--size-time", type=float, default=0.002, help="section 4: simulated time per run [s]")
+    ap.add_argument("--repeat", type=int, default=1, help="section 4: runs of each (best of)")
+    ap.add_argument("--baseline", type=Path, help="section 4 also on this checkout's code (before/after)")
     args = ap.parse_args()
     base = load_scene(CASE)
     n = len(place_particles(base).radius)
@@ -87,42 +170,72 @@ def main() -> None:
           f"{args.time:g} s simulated per run")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        print("\n1. cost of each effect (sampling every", base.time.sample_every, "steps)")
-        print(f"{'effects':>44} | {'wall s per simulated s':>22} | collisions")
-        rows = (("plain DEM (isothermal)", dict(contact_heat="none")),
-                ("collision heat A, fast path", dict(contact_heat="A", heat_path="fast")),
-                ("collision heat A, exact path", dict(contact_heat="A", heat_path="exact")),
-                ("+ restitution feedback", dict(contact_heat="A", heat_path="fast", restitution_feedback=True)),
-                ("+ enduring conduction", dict(contact_heat="A", heat_path="fast", restitution_feedback=True,
-                                               enduring_conduction=True)))
-        for k, (name, eff) in enumerate(rows):
-            wall, summary = run_host(variant(base, args.time, **eff), tmp / f"effects{k}")
-            print(f"{name:>44} | {wall / args.time:22.1f} | {summary['collisions']}")
+        if 1 in args.sections:
+            effect_costs(base, args.time, tmp)
+        if 2 in args.sections:
+            host_overhead(base, args.time, tmp)
+        if 3 in args.sections:
+            sampling_accuracy(base, args.time, tmp)
+        if 4 in args.sections:
+            print(f"\n4. heat A (fast path) against plain DEM, {args.size_time:g} s simulated "
+                  f"({round(args.size_time / base.time.dem_step)} steps) per run, engines' set-up not counted, "
+                  f"best of {args.repeat}")
+            print(f"{'code':>8} | {'particles':>9} | {'plain ms/st':>11} | {'heat ms/st':>11} | ratio | "
+                  f"{'collisions':>10} | {'us/coll':>8}")
+            size_table(heat_by_size(run_host, args.particles, args.size_time, tmp, args.repeat), "this")
+            if args.baseline:
+                size_table(baseline_sizes(args.baseline, args.particles, args.size_time, args.repeat), "baseline")
 
-        print("\n2. host overhead on the dry scene without effects")
-        dry = variant(base, args.time, contact_heat="none")
-        native = min(run_native(dry, tmp / f"native{k}") for k in range(2))
-        host = min(run_host(dry, tmp / f"host{k}")[0] for k in range(2))
-        print(f"native liggghts {native:.2f} s, host {host:.2f} s: overhead {100 * (host / native - 1):+.1f} % "
-              f"(best of 2; the native time includes its start-up)")
 
-        print("\n3. sampling interval: accuracy against sampling every step")
-        ref_scene = dataclasses.replace(variant(base, args.time, contact_heat="A", heat_path="fast"),
-                                        time=dataclasses.replace(base.time, end=args.time, sample_every=1))
-        wall_ref, ref_summary = run_host(ref_scene, tmp / "sample1")
-        ref = collisions(tmp / "sample1")
-        print(f"{'every k steps':>13} | {'wall s/sim s':>12} | {'v0 err median':>13} {'p90':>9} | "
-              f"{'total Q err':>11} | missed")
-        print(f"{1:>13} | {wall_ref / args.time:12.1f} | {'(reference)':>13} {'':>9} | {'':>11} | "
-              f"of {ref_summary['collisions']}")
-        for k in (2, 5, 10, 20, 50):
-            sc = dataclasses.replace(ref_scene, time=dataclasses.replace(ref_scene.time, sample_every=k))
-            wall, summary = run_host(sc, tmp / f"sample{k}")
-            err, missed = matched_errors(ref, collisions(tmp / f"sample{k}"), 1.01 * k * base.time.dem_step)
-            dq = summary["heat_moved"] / ref_summary["heat_moved"] - 1
-            print(f"{k:>13} | {wall / args.time:12.1f} | {np.median(err):13.2e} {np.percentile(err, 90):9.2e} | "
-                  f"{dq:+11.2e} | {missed}")
+def baseline_sizes(tree: Path, sizes, sim_time: float, repeat: int) -> list[dict]:
+    """Section 4 on the code of another checkout, in a process of its own."""
+    env = dict(os.environ, PYTHONPATH=str(tree.resolve()))
+    done = subprocess.run([sys.executable, str(Path(__file__).with_name("bench_host_baseline.py")),
+                           str(sim_time), str(repeat)] + [str(n) for n in sizes], env=env, check=True, stdout=subprocess.PIPE,
+                          text=True)
+    return json.loads(done.stdout.splitlines()[-1])
 
+
+def effect_costs(base, sim_time: float, tmp: Path) -> None:
+    print("\n1. cost of each effect (sampling every", base.time.sample_every, "steps)")
+    print(f"{'effects':>44} | {'wall s per simulated s':>22} | collisions")
+    rows = (("plain DEM (isothermal)", dict(contact_heat="none")),
+            ("collision heat A, fast path", dict(contact_heat="A", heat_path="fast")),
+            ("collision heat A, exact path", dict(contact_heat="A", heat_path="exact")),
+            ("+ restitution feedback", dict(contact_heat="A", heat_path="fast", restitution_feedback=True)),
+            ("+ enduring conduction", dict(contact_heat="A", heat_path="fast", restitution_feedback=True,
+                                           enduring_conduction=True)))
+    for k, (name, eff) in enumerate(rows):
+        wall, summary = run_host(variant(base, sim_time, **eff), tmp / f"effects{k}")
+        print(f"{name:>44} | {wall / sim_time:22.1f} | {summary['collisions']}")
+
+
+def host_overhead(base, sim_time: float, tmp: Path) -> None:
+    print("\n2. host overhead on the dry scene without effects")
+    dry = variant(base, sim_time, contact_heat="none")
+    native = min(run_native(dry, tmp / f"native{k}") for k in range(2))
+    host = min(run_host(dry, tmp / f"host{k}", whole=True)[0] for k in range(2))
+    print(f"native liggghts {native:.2f} s, host {host:.2f} s: overhead {100 * (host / native - 1):+.1f} % "
+          f"(best of 2; both with their start-up)")
+
+
+def sampling_accuracy(base, sim_time: float, tmp: Path) -> None:
+    print("\n3. sampling interval: accuracy against sampling every step")
+    ref_scene = dataclasses.replace(variant(base, sim_time, contact_heat="A", heat_path="fast"),
+                                    time=dataclasses.replace(base.time, end=sim_time, sample_every=1))
+    wall_ref, ref_summary = run_host(ref_scene, tmp / "sample1")
+    ref = collisions(tmp / "sample1")
+    print(f"{'every k steps':>13} | {'wall s/sim s':>12} | {'v0 err median':>13} {'p90':>9} | "
+          f"{'total Q err':>11} | missed")
+    print(f"{1:>13} | {wall_ref / sim_time:12.1f} | {'(reference)':>13} {'':>9} | {'':>11} | "
+          f"of {ref_summary['collisions']}")
+    for k in (2, 5, 10, 20, 50):
+        sc = dataclasses.replace(ref_scene, time=dataclasses.replace(ref_scene.time, sample_every=k))
+        wall, summary = run_host(sc, tmp / f"sample{k}")
+        err, missed = matched_errors(ref, collisions(tmp / f"sample{k}"), 1.01 * k * base.time.dem_step)
+        dq = summary["heat_moved"] / ref_summary["heat_moved"] - 1
+        print(f"{k:>13} | {wall / sim_time:12.1f} | {np.median(err):13.2e} {np.percentile(err, 90):9.2e} | "
+              f"{dq:+11.2e} | {missed}")
 
 if __name__ == "__main__":
     main()

@@ -54,16 +54,18 @@ def start_fluid(scene, folder: Path):
     return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min).start()
 
 
-def box_world(scene, out: Path, fluid_force: bool):
+def box_world(scene, out: Path, fluid_force: bool, start=None):
     """The generated DEM of a box scene: its script (run for time.end) and how the host sees
     its particles: one atom type per material, groups = the [[particles]] tables, walls
-    ``wall<k>`` = the scene's [[walls]]."""
+    ``wall<k>`` = the scene's [[walls]]. ``start``: the particles (``pyhost.dem_input.Particles``,
+    e.g. a settled bed) to start from instead of the scene's placement; the contacts present
+    then are not collisions of this run."""
     from pyhost.dem_input import input_lines, place_particles, write_data
     from pyhost.loop import HostWall
 
     folder = out / "dem"
     folder.mkdir(parents=True, exist_ok=True)
-    particles = place_particles(scene)
+    particles = place_particles(scene) if start is None else start
     data = write_data(folder / "particles.data", scene, particles)
     script = folder / "in.dem"
     steps = round(scene.time.end / scene.time.dem_step)
@@ -77,7 +79,7 @@ def box_world(scene, out: Path, fluid_force: bool):
     return script, dict(type_material=[-1] + list(range(len(index))),
                         groups=(names, lambda atoms: group_by_id[atoms.id]),
                         initial_T=lambda atoms, new: T_by_id[atoms.id[new]],
-                        walls_of=lambda dem: walls, keep_all=group_by_id)
+                        walls_of=lambda dem: walls, keep_all=group_by_id, contacts_open=start is not None)
 
 
 def user_script(scene):
@@ -126,10 +128,12 @@ def user_script(scene):
                 walls_of=walls_of)
 
 
-def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None) -> dict:
+def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None, wrap_fluid=None,
+             start=None) -> dict:
     """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
-    world, with the fluid if the scene has one. ``wrap(dem)`` may stand in front of the DEM
-    (tests inject faults with it). Returns the summary."""
+    world, with the fluid if the scene has one. ``wrap(dem)`` and ``wrap_fluid(fluid)`` may
+    stand in front of the engines (tests inject faults, benchmarks record with them);
+    ``start``: the particles a box scene starts from (see ``box_world``). Returns the summary."""
     from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
     from pyhost.loop import run_scene
@@ -145,7 +149,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         if scene.time.dem_step > t_c / 20:
             print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
                   f"({t_c:.3g} s) with fewer than 20 steps")
-        script, particles = box_world(scene, out, effects["fluid_solver"])
+        script, particles = box_world(scene, out, effects["fluid_solver"], start)
         variables = {}
     commands = read_script(script, scene.folder)
     fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None
@@ -154,7 +158,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         os.chdir(scene.folder)          # the script's relative paths, as with 'liggghts -in' there
         dem = Dem(out / "dem", variables=variables)
         try:
-            return run_scene(scene, wrap(dem) if wrap else dem, commands, out, fluid=fluid, max_time=max_time,
+            return run_scene(scene, wrap(dem) if wrap else dem, commands, out, max_time=max_time,
+                             fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
                              end=None if scene.scripted else scene.time.end, progress_every=progress_every,
                              **particles)
         finally:

@@ -95,3 +95,45 @@ def test_long_contact_is_conducted_once(tmp_path):
     assert gained == pytest.approx(expected, rel=0.01)
     assert abs(summary["energy_balance_error"]) < 1e-12
     assert summary["heat_gran_undone"] == pytest.approx(per_step[:n_coll].sum(), rel=0.02)
+
+
+class Recording:
+    """The DEM, keeping the velocities by atom id after each run."""
+
+    def __init__(self, dem):
+        self.dem, self.v = dem, None
+
+    def run(self, n):
+        self.dem.run(n)
+        a = self.dem.atoms(False)
+        self.v = a.v[np.argsort(a.id)].copy()
+
+    def __getattr__(self, name):
+        return getattr(self.dem, name)
+
+
+@pytest.mark.parametrize("touching", [False, True])
+def test_contacts_present_at_a_restart_are_not_collisions(tmp_path, touching):
+    # a run started from given particles (a restart): two spheres already in contact (10 um
+    # overlap, at rest) are a contact that was there, not a collision; the same spheres apart
+    # and closing in at 0.4 m/s collide as in the scene
+    import dataclasses
+
+    from pyhost.commands.run import simulate
+    from pyhost.dem_input import place_particles
+
+    case = tmp_path / "case.toml"
+    case.write_text(TWO)
+    scene = load_scene(case)
+    scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=1e-3))
+    start = place_particles(scene)
+    if touching:
+        start = dataclasses.replace(start, position=start.position + [[0, 0, 0], [-2.1e-4, 0, 0]],
+                                    velocity=0.0 * start.velocity)
+    dem = {}
+    summary = simulate(scene, tmp_path / "out", progress_every=1e9, start=start,
+                       wrap=lambda d: dem.setdefault("d", Recording(d)))
+    assert summary["collisions"] == (0 if touching else 1)
+    assert (summary["heat_moved"] == 0.0) if touching else (summary["heat_moved"] > 0)
+    v = dem["d"].v
+    assert np.isfinite(v).all() and v[0, 0] < 0 < v[1, 0]      # apart again (with restitution feedback on)

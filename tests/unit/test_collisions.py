@@ -106,3 +106,44 @@ def test_heat_exchange_with_walls_balances():
     # a conductance above the particle's heat capacity is capped: the particle reaches the wall's T
     _, capped, _ = exchange_heat(T, C, np.array([0]), np.array([WALL_BASE]), np.array([10.0]), T_wall)
     assert capped == 1 and T[0] == pytest.approx(320.0)
+
+
+def exchange_one_by_one(T, C, i, j, G, T_wall):
+    """The definition of exchange_heat: one collision after the other (reference)."""
+    moved, capped, from_walls = np.zeros(len(G)), 0, 0.0
+    for k, (a, b, g) in enumerate(zip(i, j, G)):
+        if b >= WALL_BASE:
+            tw = T_wall[b - WALL_BASE]
+            if np.isnan(tw):
+                continue
+            limit, dT = C[a], T[a] - tw
+        else:
+            limit, dT = C[a] * C[b] / (C[a] + C[b]), T[a] - T[b]
+        if g > limit:
+            g, capped = limit, capped + 1
+        q = g * dT
+        T[a] -= q / C[a]
+        if b >= WALL_BASE:
+            from_walls -= q
+        else:
+            T[b] += q / C[b]
+        moved[k] = q
+    return moved, capped, from_walls
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_heat_exchange_in_rounds_is_bit_identical_to_one_by_one(seed):
+    # few particles, many collisions: each particle meets several partners in one call,
+    # with hot, fixed-temperature and adiabatic walls and capped conductances among them
+    rng = np.random.default_rng(seed)
+    n, m = int(rng.integers(2, 30)), int(rng.integers(1, 300))
+    T0, C = rng.uniform(250, 450, n), rng.uniform(1e-4, 1e-1, n)
+    i = rng.integers(0, n, m)
+    j = np.where(rng.random(m) < 0.2, WALL_BASE + rng.integers(0, 3, m), (i + rng.integers(1, n, m)) % n)
+    G = rng.uniform(0, 2e-2, m) * np.where(rng.random(m) < 0.1, 100.0, 1.0)
+    T_wall = np.array([320.0, np.nan, 500.0])
+    T_ref, T = T0.copy(), T0.copy()
+    ref = exchange_one_by_one(T_ref, C, i, j, G, T_wall)
+    got = exchange_heat(T, C, i, j, G, T_wall)
+    assert np.array_equal(T, T_ref) and np.array_equal(got[0], ref[0])
+    assert got[1] == ref[1] and got[2] == ref[2] and str(got[2]) == str(ref[2])
