@@ -18,10 +18,15 @@ def plot_history(out: Path) -> Path:
     rows = list(csv.DictReader(open(out / "history.csv")))
     t = np.array([float(r["time"]) for r in rows])
     groups = sorted(k for k in rows[0] if k.startswith("T_group"))
+    names = _group_names(out)
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
     for k in groups:
         T = np.array([float(r[k]) for r in rows])
-        ax1.plot(t * 1e3, T - T[0], label=f"group {k[7:]} (from {T[0]:.5g} K)")
+        seen = np.flatnonzero(np.isfinite(T))
+        if not len(seen):                   # a group with no particle (a material of walls only)
+            continue
+        name = names[int(k[7:])] if int(k[7:]) < len(names) else f"group {k[7:]}"
+        ax1.plot(t * 1e3, T - T[seen[0]], label=f"{name} (from {T[seen[0]]:.5g} K)")
     ax1.set_xlabel("time [ms]")
     ax1.set_ylabel("mean temperature change [K]")
     ax1.legend()
@@ -31,6 +36,43 @@ def plot_history(out: Path) -> Path:
     ax2.set_ylabel("collisions so far")
     ax2.grid(alpha=0.3)
     return _save(fig, out / "temperatures.png")
+
+
+def _group_names(out: Path) -> list:
+    """The names of the history's temperature groups, from the run's summary.json."""
+    import json
+
+    try:
+        return list(json.loads((out / "summary.json").read_text()).get("groups", []))
+    except (OSError, ValueError):
+        return []
+
+
+def temperature_change(pvd: Path):
+    """Each particle's temperature change [K] in the last frame of a particle series since the
+    first frame it appears in (so inserted particles start from their own first value)."""
+    import pyvista
+
+    reader = pyvista.get_reader(str(pvd))
+    first = {}
+    for time in reader.time_values:
+        reader.set_active_time_value(time)
+        frame = reader.read()[0]
+        if frame.n_points:
+            ids, T = np.asarray(frame.point_data["id"]), np.asarray(frame.point_data["temperature"])
+            for i, value in zip(ids.tolist(), T.tolist()):
+                first.setdefault(i, value)
+    ids, T = np.asarray(frame.point_data["id"]), np.asarray(frame.point_data["temperature"])
+    return T - np.array([first[i] for i in ids.tolist()])
+
+
+def change_scale(dT):
+    """Colour limits symmetric about zero, only as wide as the largest change, and the unit:
+    mK below 1 K (a collision moves little heat: a scale over the temperatures would show none)."""
+    top = float(np.nanmax(np.abs(dT))) if np.size(dT) and np.isfinite(dT).any() else 0.0
+    factor, unit = (1e3, "mK") if top < 1.0 else (1.0, "K")
+    top = max(top * factor, 1e-9)
+    return factor, unit, (-top, top)
 
 
 def _save(fig, path: Path) -> Path:
@@ -91,7 +133,7 @@ def _frame(pvd: Path, t: float | None = None):
 
 def render_particles(out: Path) -> Path:
     """The last VTK frame rendered off screen -> out/particles.png: the particles as spheres
-    coloured by temperature [K]. For a fluid run (out/vtk/fluid.pvd) they are drawn over the
+    coloured by their temperature change since they first appear (``change_scale``). For a fluid run (out/vtk/fluid.pvd) they are drawn over the
     fluid volume fraction [-] of the same frame: the mid-y slice of the fluid cells (domain box
     and plenum below it), placed at the back face and viewed from the front (-y), framed on the
     bed (plenum to a little above the highest particle), so a pseudo-2-D bed reads like the
@@ -100,17 +142,26 @@ def render_particles(out: Path) -> Path:
 
     pyvista.OFF_SCREEN = True
     cloud, t = _frame(out / "vtk" / "particles.pvd")
+    dT = temperature_change(out / "vtk" / "particles.pvd")
+    factor, unit, clim = change_scale(dT)
+    cloud.point_data["change"] = dT * factor
     spheres = cloud.glyph(geom=pyvista.Sphere(theta_resolution=12, phi_resolution=12), scale="radius",
                           factor=2.0, orient=False)
-    has_fluid = (out / "vtk" / "fluid.pvd").exists()
+    grid = None
+    if (out / "vtk" / "fluid.pvd").exists():
+        cells, _ = _frame(out / "vtk" / "fluid.pvd", t)
+        try:
+            grid = fluid_grid(cells.points, cells.point_data["alpha"], _fluid_box(out))
+        except ValueError as exc:           # a user's own mesh: not drawn as a slice (yet)
+            print(f"note: fluid fraction not drawn: {exc}")
+    has_fluid = grid is not None
     plotter = pyvista.Plotter(off_screen=True, window_size=WINDOW_FLUID if has_fluid else WINDOW)
     bar = dict(vertical=True, width=0.05, height=0.5, position_y=0.25, title_font_size=14, label_font_size=14)
-    plotter.add_mesh(spheres, scalars="temperature", cmap="coolwarm",
-                     scalar_bar_args=dict(bar, title="temperature [K]\n", position_x=0.88, fmt="%.0f")
-                     if has_fluid else {"title": "temperature [K]"})
+    title = f"temperature change [{unit}]"
+    plotter.add_mesh(spheres, scalars="change", cmap="coolwarm", clim=clim,
+                     scalar_bar_args=dict(bar, title=title + "\n", position_x=0.88, fmt="%.3g")
+                     if has_fluid else {"title": title})
     if has_fluid:
-        cells, _ = _frame(out / "vtk" / "fluid.pvd", t)
-        grid = fluid_grid(cells.points, cells.point_data["alpha"], _fluid_box(out))
         x0, x1, y0, y1, z0, z1 = grid.bounds
         back = grid.slice(normal="y", origin=grid.center).translate((0, y1 + 0.02 * (y1 - y0) - grid.center[1], 0))
         lo = min(np.floor(10 * np.nanmin(grid.cell_data["alpha"])) / 10, 0.9)
@@ -144,6 +195,8 @@ def _fluid_box(out: Path):
     if not (out / "scene.json").exists():
         return None
     scene = json.loads((out / "scene.json").read_text())
+    if not scene.get("domain"):             # a script scene: the user's own fluid mesh
+        return None
     box = list(scene["domain"]["box"])
     box[4] -= (scene.get("fluid") or {}).get("plenum", 0.0)
     return box
@@ -162,10 +215,8 @@ def plot_post(out: Path, last, pair_names, times, pair_heat) -> Path:
 
     t, x, dT, model = last
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
-    span = float(np.abs(dT).max()) if len(dT) else 0.0
-    scale, unit = (1e3, "mK") if span < 1.0 else (1.0, "K")
-    span = span * scale or 1.0
-    dots = ax1.scatter(x[:, 0] * 1e3, x[:, 2] * 1e3, c=dT * scale, cmap="coolwarm", vmin=-span, vmax=span, s=12)
+    scale, unit, (low, high) = change_scale(dT)
+    dots = ax1.scatter(x[:, 0] * 1e3, x[:, 2] * 1e3, c=dT * scale, cmap="coolwarm", vmin=low, vmax=high, s=12)
     fig.colorbar(dots, ax=ax1, label=f"temperature change [{unit}], model {model}")
     ax1.set_xlabel("x [mm]")
     ax1.set_ylabel("z [mm]")

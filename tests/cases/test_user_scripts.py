@@ -150,3 +150,24 @@ run 10""")
     r, _ = run(tmp_path)
     assert r.returncode == 2
     assert "atom type(s) [2] have no material" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_silo_with_the_users_openfoam_case(tmp_path):
+    """The same script with gas up through the user's hand-written OpenFOAM case (fluid/):
+    the host copies the case, collheatFoam solves it, the particles feel it, the balance
+    still closes, and the user's own case folder is left as it was."""
+    case = tmp_path / "silo-heat"
+    shutil.copytree(ROOT / "cases" / "silo-heat", case, ignore=shutil.ignore_patterns("output", "post", "log.*"))
+    (case / "post").mkdir()
+    text = (case / "case.toml").read_text()
+    (case / "case.toml").write_text(text.replace("[effects]\n", "[effects]\nfluid = true\n").replace(
+        "[time]\n", '[fluid]\ncase = "fluid"\ndrag = "difelice"\n\n[time]\ncouple_every = 20\n'))
+    before = sorted(p.relative_to(case) for p in (case / "fluid").rglob("*"))
+    r, summary = run(case, "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert sorted(p.relative_to(case) for p in (case / "fluid").rglob("*")) == before
+    assert abs(summary["energy_balance_error"]) < 1e-12 and summary["inserted"] == 900
+    rows = list(csv.DictReader(open(case / "out" / "history.csv")))
+    drop = float(rows[-1]["pressure_drop"])
+    assert math.isfinite(drop) and drop > 0                 # the settled bed resists the gas
+    assert (case / "out" / "vtk" / "fluid.pvd").exists()
