@@ -222,6 +222,7 @@ def main() -> None:
     ap.add_argument("--compare", type=float, default=0.004, help="table 2's comparison, after the start [s]")
     ap.add_argument("--reference", type=int, default=1, help="coupling interval of the reference [DEM steps]")
     ap.add_argument("--repeat", type=int, default=2, help="runs per row of table 1 (best of)")
+    ap.add_argument("--effects-only", action="store_true", help="table 1 only")
     ap.add_argument("--fluid-step", action="store_true",
                     help="instead of the tables: the fluid step's effect on a frozen bed (about 1 min)")
     args = ap.parse_args()
@@ -256,6 +257,8 @@ def main() -> None:
             wall = min(r[0] for r in runs)
             count = runs[0][1]["collisions"] if eff["contact_heat"] != "none" else "-"
             print(f"{name:>40} | {wall / end:22.0f} | {count}", flush=True)
+        if args.effects_only:
+            return
 
         print(f"\n2a. coupling interval against every {args.reference} DEM step(s), from the initial placement")
         interval_table(base, end, compare, args.reference, weight, tmp / "a")
