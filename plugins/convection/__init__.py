@@ -6,7 +6,8 @@ the exchange of heat between particles and the gas of their cells over a couplin
 - ``conductance(name, re, pr, alpha, k_g, d)``: G = h A = Nu k_g / d * pi d^2 [W/K];
 - ``outside(name, re, pr, alpha)``: per quantity, the fraction of values outside the range
   where the correlation rests on data (an extrapolation there, not an error);
-- ``exchange(...)``: see ``plugins.convection.exchange``.
+- ``exchange(...)``: see ``plugins.convection.exchange``;
+- ``particle_reynolds``, ``prandtl``: the dimensionless groups the correlations take.
 """
 from __future__ import annotations
 
@@ -15,7 +16,8 @@ import numpy as np
 from plugins.convection.exchange import exchange
 from plugins.convection.nusselt import CORRELATIONS, Correlation
 
-__all__ = ["CORRELATIONS", "Correlation", "get", "heat_transfer_coefficient", "conductance", "outside", "exchange"]
+__all__ = ["CORRELATIONS", "Correlation", "get", "heat_transfer_coefficient", "conductance", "outside", "exchange",
+           "particle_reynolds", "prandtl"]
 
 
 def get(name: str) -> Correlation:
@@ -48,3 +50,13 @@ def outside(name: str, re, pr, alpha) -> dict:
         if frac > 0:
             found[key] = frac
     return found
+
+
+def particle_reynolds(alpha, slip, d, nu):
+    """Re_p = alpha |u - v| d / nu (-): the superficial slip velocity, as the correlations take it."""
+    return np.asarray(alpha) * slip * d / nu
+
+
+def prandtl(nu, rho, cp, k):
+    """Pr = nu rho c_p / k (-) of the gas."""
+    return nu * rho * cp / k

@@ -49,7 +49,8 @@ def test_valid_scene_loads_with_defaults(tmp_path):
     assert s.materials["steel"].dem.friction == 0.3             # default
     assert s.time.sample_every == 1 and s.fluid is None
     effects = s.effects_summary()
-    assert effects == dict(fluid_solver=False, contact_extraction=True, collision_heat=True,
+    assert effects == dict(fluid_solver=False, convection=False, particle_temperatures=True,
+                           contact_extraction=True, collision_heat=True,
                            restitution_feedback=False, enduring_conduction=False, wall_heat=True)
 
 
