@@ -54,7 +54,7 @@ cells = [{nx}, 1, 8]
 [time]
 dem_step = 1e-5
 end = {end}
-couple_every = 10
+couple_every = {couple}
 
 [output]
 every = {every}
@@ -85,7 +85,7 @@ def test_particle_in_a_hot_stream_follows_the_lumped_solution(tmp_path):
     d, rho, c, u, nu, k, cp = 1e-3, 2500.0, 10.0, 1.0, 1.8e-5 / 1.2, 0.026, 1005.0
     summary, rows = run(tmp_path, model="none", correlation="ranz_marshall", c=c, count=1,
                         where="positions = [[0.02, 0.02, 0.0005]]", spread=0.0,
-                        walls='[[walls]]\nplane = "zlo"\nmaterial = "glass"', u=u, plenum=0.01, nx=1,
+                        walls='[[walls]]\nplane = "zlo"\nmaterial = "glass"', u=u, plenum=0.01, nx=1, couple=10,
                         end=0.06, every=1e-3)
     Re, Pr = u * d / nu, nu * 1.2 * cp / k
     h = (2 + 0.6 * Re**0.5 * Pr ** (1 / 3)) * k / d
@@ -109,7 +109,7 @@ def test_energy_of_particles_and_gas_is_kept_step_by_step(tmp_path):
     walls = "\n".join(f'[[walls]]\nplane = "{p}"\nmaterial = "glass"' for p in ("zlo", "xlo", "xhi", "ylo", "yhi", "zhi"))
     summary, rows = run(tmp_path, model="A", correlation="gunn", c=840.0, count=30,
                         where="region = [0.005, 0.035, 0.005, 0.035, 0.001, 0.02]", spread=0.3, walls=walls,
-                        u=1.0, plenum=0.0, nx=4, end=0.01, every=1e-4)
+                        u=1.0, plenum=0.0, nx=4, couple=10, end=0.01, every=1e-4)
     total = np.array([r["sum_mcT"] + r["gas_energy"] - r["heat_through_fluid_boundaries"] - r["heat_from_walls"]
                       for r in rows])
     step = np.abs(np.diff(total)) / total[1:]
@@ -119,3 +119,67 @@ def test_energy_of_particles_and_gas_is_kept_step_by_step(tmp_path):
     assert step.max() < 1e-9
     assert abs(summary["total_energy_balance_error"]) < 1e-9
     assert abs(summary["energy_balance_error"]) < 1e-12
+
+
+def schumann_gas(xi, eta):
+    """Schumann (1929), J. Franklin Inst. 208, 405-416: gas temperature (T - T0)/(T_in - T0)
+    at dimensionless depth xi = h a z / (rho_g c_g u_s) and time eta = h a (t - eps z / u_s)
+    / ((1 - eps) rho_s c_s) in a bed at T0 fed with gas at T_in from t = 0, without axial
+    conduction: 1 - int_0^xi exp(-s - eta) I0(2 sqrt(s eta)) ds (checked against a
+    method-of-lines solution of the two equations to 1e-8 while writing this test)."""
+    from scipy.integrate import quad
+    from scipy.special import i0e
+    if eta <= 0:
+        return 0.0
+    f = lambda s: np.exp(-s - eta + 2 * np.sqrt(s * eta)) * i0e(2 * np.sqrt(s * eta))
+    return 1.0 - quad(f, 0.0, xi)[0]
+
+
+def test_packed_bed_heated_by_hot_gas_breaks_through_as_schumann(tmp_path):
+    """A simple-cubic bed of 192 touching 2 mm spheres (12 layers, one per fluid cell,
+    eps = 1 - pi/6) held by walls, fed from t = 0 with gas at 400 K at 0.3 m/s through a 2 mm
+    plenum; bed and gas at 300 K. Gunn's h (written out). The gas's heat capacity
+    (15000 J/(kg K)) and the solid's (10 J/(kg K)) are chosen so that the bed is xi_L = 2.5
+    long and breaks through in 0.17 s. The outlet temperature follows from the heat that
+    entered through the fluid's boundaries, d/dt Q = rho_g c_g u_s A (T_in - T_out).
+    Within 5 % of T_in - T0 of Schumann's solution over the whole curve but where the
+    front arrives (|eta| < 0.5): there the solution jumps from 0 to exp(-xi_L) = 0.08, which a
+    finite-volume gas smears over a few cells."""
+    d, n, layers = 2e-3, 4, 12
+    side, L, u, cp, cs, rho_s, plenum = n * d, layers * d, 0.3, 15000.0, 10.0, 2500.0, 2e-3
+    axis = (np.arange(n) + 0.5) * d
+    positions = [[x, y, (k + 0.5) * d] for k in range(layers) for y in axis.tolist() for x in axis.tolist()]
+    walls = "\n".join(f'[[walls]]\nplane = "{p}"\nmaterial = "glass"' for p in ("zlo", "xlo", "xhi", "ylo", "yhi", "zhi"))
+    scene = (SCENE.replace("box = [0.0, 0.04, 0.0, 0.04, 0.0, 0.04]", f"box = [0.0, {side}, 0.0, {side}, 0.0, {L}]\n"
+                                                                        "gravity = [0.0, 0.0, 0.0]")
+             .replace("cells = [{nx}, 1, 8]", f"cells = [1, 1, {layers + 1}]\nheat_capacity = {cp}\n"
+                                                "inlet_temperature = 400.0\ntemperature = 300.0")
+             .replace("heat_capacity = 1005.0\ntemperature = 400.0\n", "")
+             .replace("youngs_modulus = 5e6", "youngs_modulus = 5e7")      # drag barely packs the bed
+             .replace("dem_step = 1e-5", "dem_step = 5e-6")
+             .replace("radius = 0.5e-3", "radius = 1e-3"))
+    (tmp_path / "case.toml").write_text(scene.format(model="none", correlation="gunn", c=cs, count=len(positions),
+                                                     where=f"positions = {positions}", spread=0.0, walls=walls, u=u,
+                                                     couple=20, plenum=plenum, end=0.17, every=1.5e-3))
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=900)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    with open(tmp_path / "out" / "history.csv") as f:
+        rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+    eps, nu, k, rho_g = 1 - np.pi / 6, 1.8e-5 / 1.2, 0.026, 1.2
+    Re, Pr = u * d / nu, nu * rho_g * cp / k
+    nusselt = ((7 - 10 * eps + 5 * eps**2) * (1 + 0.7 * Re**0.2 * Pr ** (1 / 3))
+               + (1.33 - 2.4 * eps + 1.2 * eps**2) * Re**0.7 * Pr ** (1 / 3))
+    ha = nusselt * k / d * 6 * (1 - eps) / d
+    xi = ha * L / (rho_g * cp * u)
+    t = np.array([row["time"] for row in rows])
+    Q = np.array([row["heat_through_fluid_boundaries"] for row in rows])
+    rate = np.gradient(Q, t)
+    theta_out = 1 - rate / (rho_g * cp * u * side**2 * 100.0)
+    eta = ha * (t - plenum / u - eps * L / u) / ((1 - eps) * rho_s * cs)
+    expected = np.array([schumann_gas(xi, e) for e in eta])
+    error = np.abs(theta_out - expected)[np.abs(eta) > 0.5]
+    print(f"xi_L {xi:.3f}, eta_end {eta[-1]:.2f}, theta_out end {theta_out[-1]:.4f} vs {expected[-1]:.4f}, "
+          f"max error {error.max():.3%}")
+    assert 1.5 < xi < 3 and eta[-1] > 5
+    assert error.max() < 0.05
