@@ -41,7 +41,8 @@ from pyhost.script import ScriptError, parse_run
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
-GAS_COLUMNS = ("T_gas_mean", "gas_energy", "heat_convected", "heat_through_fluid_boundaries")
+GAS_COLUMNS = ("T_gas_mean", "gas_energy", "heat_convected", "heat_convected_gross", "heat_through_fluid_boundaries",
+               "heat_moved")
 
 
 @dataclass(frozen=True)
@@ -97,7 +98,7 @@ class Coupling:
         self.totals = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0,
                            heat_from_walls=0.0, capped=0, clipped=0, heat_gran_undone=0.0,
                            inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0,
-                           heat_convected=0.0)
+                           heat_convected=0.0, heat_convected_gross=0.0)
         self.CT_by_id = np.zeros(0)      # m c T of each id at its last sample [J] (energy balance)
         self.seen = np.zeros(0, bool)
         self.warned = set()
@@ -385,6 +386,7 @@ class Coupling:
         q, _ = convection.exchange(atoms.T, self.C, G, f.cell, f.temperature(), f.heat_capacity(), interval)
         atoms.T[:] += q / self.C
         self.totals["heat_convected"] += float(q.sum())
+        self.totals["heat_convected_gross"] += float(np.abs(q).sum())
         self.track_particles(atoms)
         return -np.bincount(f.cell, q, len(f.cell_volumes)) / interval
 
@@ -402,12 +404,15 @@ class Coupling:
 
     def gas_state(self) -> tuple:
         """The gas columns of history.csv: the heat-capacity weighted mean gas temperature [K],
-        the gas's heat content rho c alpha V T summed over cells [J], the heat convected into
-        the particles [J] and the heat into the gas through the fluid's boundaries [J], each
-        since the start."""
+        the gas's heat content rho c alpha V T summed over cells [J]; since the start [J]: the
+        heat convected into the particles (net, and the sum of its magnitudes), the heat into
+        the gas through the fluid's boundaries, and beside them the heat moved by collisions
+        between particles (sum of magnitudes)."""
         C = self.fluid.heat_capacity()
         E = float(np.sum(C * self.fluid.temperature()))
-        return (E / C.sum(), E, self.totals["heat_convected"], self.fluid.boundary_heat)
+        t = self.totals
+        return (E / C.sum(), E, t["heat_convected"], t["heat_convected_gross"], self.fluid.boundary_heat,
+                t["heat_moved"])
 
     # -- output -------------------------------------------------------------------------
     def write_frame(self) -> None:
@@ -447,7 +452,7 @@ class Coupling:
             summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT,
                            energy_balance_error=residual / max(came_in, 1e-300))             # relative to all that came in
             if self.convection and status == "completed":   # particles and gas; the gas gains through its boundaries
-                _, gas, _, through = self.gas_state()
+                _, gas, _, _, through, _ = self.gas_state()
                 residual += t["heat_convected"] + gas - self.gas_energy0 - through
                 summary.update(gas_energy_start=self.gas_energy0, gas_energy_end=gas,
                                heat_through_fluid_boundaries=through,
