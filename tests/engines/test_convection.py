@@ -183,3 +183,32 @@ def test_packed_bed_heated_by_hot_gas_breaks_through_as_schumann(tmp_path):
           f"max error {error.max():.3%}")
     assert 1.5 < xi < 3 and eta[-1] > 5
     assert error.max() < 0.05
+
+
+def test_gas_energy_on_one_and_two_ranks(tmp_path):
+    """collheatFoam -energy alone: hot inlet, a wall at 500 K, 0.5 W into one cell, 50 steps.
+    The gas's heat content changes by what entered through the boundaries plus the source,
+    to 1e-10 (the pressure and T solvers' tolerances, summed over ranks); two ranks give
+    the serial temperatures within 1e-3 K."""
+    from pyhost.fluid_case import box_case
+    from pyhost.openfoam import FluidSolver
+
+    temperatures = {}
+    for n in (1, 2):
+        case = box_case(tmp_path / f"ranks{n}", lo=(0, 0, 0), hi=(0.02, 0.01, 0.05), cells=(4, 1, 10),
+                        boundaries={"xlo": "wall", "xhi": "slip", "ylo": "slip", "yhi": "slip",
+                                    "zlo": ("inlet", (0, 0, 0.5)), "zhi": "outlet"},
+                        rho=1.2, nu=1.5e-5, gravity=(0, 0, 0), dt=1e-3, nprocs=n,
+                        T0=300.0, T_inlet=400.0, T_walls={"xlo": 500.0})
+        with FluidSolver(case, energy=True, nprocs=n) as fluid:
+            before = np.sum(fluid.heat_capacity() * fluid.temperature())
+            heat = np.zeros(len(fluid.cell_volumes))
+            heat[np.argmin(np.linalg.norm(fluid.cell_centres - [0.01, 0.005, 0.02], axis=1))] = 0.5    # W
+            for _ in range(50):
+                fluid.advance(1e-3, heat=heat)
+            T = fluid.temperature()
+            after = np.sum(fluid.heat_capacity() * T)
+            assert abs(after - before - fluid.boundary_heat - 0.5 * 0.05) < 1e-10 * after
+            assert fluid.boundary_heat > 0.1                   # the hot inlet's enthalpy came in
+            temperatures[n] = T[np.lexsort(np.round(fluid.cell_centres, 9).T)]
+    assert np.abs(temperatures[1] - temperatures[2]).max() < 1e-3
