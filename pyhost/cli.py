@@ -17,7 +17,7 @@ import sys
 from pyhost.exitcodes import classify
 from pyhost.signals import stopping
 
-COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench")
+COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench", "post", "compare")
 
 
 class UserError(Exception):

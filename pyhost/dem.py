@@ -183,15 +183,17 @@ class Dem:
     # -- contacts ---------------------------------------------------------------------
     def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:
         """Every contact now (see :class:`Contacts`). ``wall_index``: host wall index of each
-        wall/gran fix id; a particle touching several triangles of one mesh wall is one contact
-        (the deepest)."""
+        (wall/gran fix id, mesh index in the fix); a particle touching several triangles of one
+        mesh is one contact (the deepest)."""
         parts = [self._pair_contacts()]
         for fix, wall in self.info.walls.items():
             if wall.primitive is not None:
-                parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix]))
+                parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix, 0]))
         mesh_fixes = [f for f, w in self.info.walls.items() if w.meshes]
         if mesh_fixes:
-            parts.append(self._mesh_contacts(WALL_BASE + wall_index[mesh_fixes[-1]]))
+            fix = mesh_fixes[-1]
+            codes = [WALL_BASE + wall_index[fix, k] for k in range(len(self.info.walls[fix].meshes))]
+            parts.append(self._mesh_contacts(np.array(codes, np.int64)))
         return _concat(parts)
 
     def _local(self, which: str):
@@ -222,18 +224,20 @@ class Dem:
         return Contacts(ids[:, 0].astype(np.int64), ids[:, 1].astype(np.int64), delta, n,
                         -np.einsum("ij,ij->i", vi - vj, n), flux)
 
-    def _mesh_contacts(self, wall: int) -> Contacts:
+    def _mesh_contacts(self, codes: np.ndarray) -> Contacts:
         a, c = self._local("wall_compute")
         cp, xp = a[:, c["pos"]][:, :3], a[:, c["pos"]][:, 3:]
         vw, vp = a[:, c["vel"]][:, :3], a[:, c["vel"]][:, 3:]
         pid = a[:, c["id"]][:, 2].astype(np.int64)
+        wall = codes[a[:, c["id"]][:, 0].astype(np.int64)]
         d = xp - cp
         dist = np.linalg.norm(d, axis=1)
         n = d / np.where(dist > 0, dist, 1.0)[:, None]
         delta = a[:, c["delta"]][:, 0] if "delta" in c else self.lmp.radii_of(pid) - dist
-        order = np.lexsort((-delta, pid))                  # deepest triangle of each particle first
-        first = order[np.r_[True, pid[order][1:] != pid[order][:-1]]] if len(pid) else order
-        return Contacts(pid[first], np.full(len(first), wall, np.int64), delta[first], n[first],
+        order = np.lexsort((-delta, wall, pid))        # deepest triangle of each particle and mesh first
+        new = np.r_[True, (pid[order][1:] != pid[order][:-1]) | (wall[order][1:] != wall[order][:-1])]
+        first = order[new] if len(pid) else order
+        return Contacts(pid[first], wall[first], delta[first], n[first],
                         -np.einsum("ij,ij->i", vp[first] - vw[first], n[first]), np.zeros(len(first)))
 
 

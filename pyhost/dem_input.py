@@ -143,6 +143,12 @@ def input_lines(scene: Scene, data_file: Path, skin: float | None = None) -> lis
     return lines
 
 
+def hertz_collision_time(Estar, Rstar, mstar, v):
+    """Duration [s] of an elastic Hertz impact at speed v [m/s] with effective modulus Estar
+    [Pa], radius Rstar [m] and mass mstar [kg] (eq. 32)."""
+    return 2.0 * K_HERTZ * (15.0 / 16.0) ** 0.4 * (mstar**2 / (Estar**2 * Rstar * v)) ** 0.2
+
+
 def dem_collision_time(scene: Scene, v: float) -> float:
     """Shortest Hertz collision time of the DEM among the scene's particles at impact speed
     v [m/s] (eq. 32 with the DEM's softened modulus) [s]: the DEM step must resolve it."""
@@ -150,6 +156,6 @@ def dem_collision_time(scene: Scene, v: float) -> float:
     for grp in scene.particles:
         m = scene.materials[grp.material]
         E = m.dem.youngs_modulus / (2.0 * (1.0 - m.dem.poisson_ratio**2))
-        R, mass = grp.radius / 2.0, 4.0 / 3.0 * math.pi * grp.radius**3 * m.density / 2.0
-        times.append(2.0 * K_HERTZ * (15.0 / 16.0) ** 0.4 * (mass**2 / (E**2 * R * v)) ** 0.2)
+        mass = 4.0 / 3.0 * math.pi * grp.radius**3 * m.density
+        times.append(hertz_collision_time(E, grp.radius / 2.0, mass / 2.0, v))
     return min(times)

@@ -213,16 +213,22 @@ class Liggghts:
             return
         self.helper.collheat_flush(self.ptr)
         trial = self.workdir / "log.trial"
-        pid = os.fork()
-        if pid == 0:  # the copy: never returns into Python's normal flow
-            try:
-                self.helper.collheat_watch_exit(self.ptr, b"")  # the parent reports, not the copy
-                self.helper.collheat_set_screen(self.ptr, str(trial).encode())
-                call()
-                self.helper.collheat_flush(self.ptr)
-            finally:
-                os._exit(0)
-        status = self._wait_trial(pid, trial)
+        # Interrupts wait until the trial is over: a handler's exception raised inside fork's
+        # hooks would be swallowed, and the copy must not run Python's handlers at all.
+        mask = signal.pthread_sigmask(signal.SIG_BLOCK, (signal.SIGINT, signal.SIGTERM, signal.SIGHUP))
+        try:
+            pid = os.fork()
+            if pid == 0:  # the copy: never returns into Python's normal flow
+                try:
+                    self.helper.collheat_watch_exit(self.ptr, b"")  # the parent reports, not the copy
+                    self.helper.collheat_set_screen(self.ptr, str(trial).encode())
+                    call()
+                    self.helper.collheat_flush(self.ptr)
+                finally:
+                    os._exit(0)
+            status = self._wait_trial(pid, trial)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
         if os.waitstatus_to_exitcode(status) != 0:
             text = trial.read_text(errors="replace") if trial.exists() else ""
             trial.unlink(missing_ok=True)

@@ -30,8 +30,10 @@ from pathlib import Path
 import numpy as np
 
 from plugins import convection
-from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat
-from pyhost.contact_heat import evaluate, restitution_impulse
+from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
+                               temperature_difference)
+from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
+from pyhost import signals
 from pyhost.dem import Dem
 from pyhost.failures import particles_lost
 from pyhost.liggghts import LiggghtsError
@@ -47,12 +49,14 @@ GAS_COLUMNS = ("T_gas_mean", "gas_energy", "heat_convected", "heat_convected_gro
 
 @dataclass(frozen=True)
 class HostWall:
-    """A LIGGGHTS wall as the host sees it: its fix id, its real material (index into the
+    """A LIGGGHTS wall as the host sees it: its fix id (and the index of the mesh within a
+    mesh wall fix: each mesh is a wall of its own), its real material (index into the
     scene's materials) and its fixed temperature [K] (NaN: adiabatic)."""
 
     fix: str
     material: int
     temperature: float
+    mesh: int = 0
 
 
 def layer_pressure_drop(fluid) -> float:
@@ -86,7 +90,7 @@ class Coupling:
         self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
         self.before = None
         self.walls = walls
-        self.wall_index = {w.fix: k for k, w in enumerate(walls)}
+        self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
         self.T_wall = np.array([w.temperature if self.effects["wall_heat"] else np.nan for w in walls])
         self.wall_material = np.array([w.material for w in walls], int)
         self.capacity = np.array([m.heat_capacity for m in self.materials])
@@ -111,7 +115,8 @@ class Coupling:
         self.track_particles(atoms)
         self.CT0 = self.totals.pop("energy_in")
         self.totals["energy_in"] = 0.0
-        self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS)
+        self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS
+                                 + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:]))
         self.history = CsvLog(self.out / "history.csv", ("time", "particles", "T_mean", "T_min", "T_max")
                               + tuple(f"T_group{k}" for k in range(len(self.group_names)))
                               + ("sum_mcT", "heat_from_walls", "energy_in", "energy_out", "collisions",
@@ -123,8 +128,12 @@ class Coupling:
         self.every = dict(sample=scene.time.sample_every if self.effects["contact_extraction"] else 0,
                           frame=max(1, round(scene.output.every / dem.dt)),
                           couple=scene.time.couple_every if fluid is not None else 0)
+
+    def start(self) -> None:
+        """The first fluid exchange and the first frame (after construction, so that an
+        interrupt from here on finds a coupling to write its summary)."""
         T_gas = self.fluid.temperature() if self.convection else None
-        if fluid is not None:
+        if self.fluid is not None:
             self.couple_fluid()
         # the solver starts from the first fluid fraction it gets (no flow displaces the gas of
         # the particles as placed): the gas's initial heat content with that fraction
@@ -142,6 +151,7 @@ class Coupling:
                 a = self.dem.atoms(False)
                 self.before = (self.t, a.id.copy(), a.x.copy(), a.v.copy())
             self.dem.run(chunk)
+            signals.check()
             if self.keep_all is not None and self.dem.lmp.nlocal < len(self.before[1]):
                 self.lost()
             n -= chunk
@@ -266,7 +276,7 @@ class Coupling:
         mat_i = self.materials_of(atoms.type[i])
         wall_mat = np.where(self.wall_material[w] >= 0, self.wall_material[w], mat_i) if len(self.walls) else mat_i
         mat = np.where(wall, wall_mat, self.materials_of(atoms.type[jj]))
-        wall_type = np.array([self.dem.info.wall_type(wl.fix) or 1 for wl in self.walls] or [1])
+        wall_type = np.array([self.dem.info.wall_type(wl.fix, wl.mesh) or 1 for wl in self.walls] or [1])
         typ = np.where(wall, wall_type[w], atoms.type[jj])
         return (wall, jl, mat, typ, np.where(wall, np.inf, atoms.radius[jj]),
                 np.where(wall, np.inf, atoms.mass[jj]))
@@ -288,15 +298,23 @@ class Coupling:
             self.warned.add("model")
             print(f"warning: the DEM's normal model is '{self.dem.info.pair_model}', not hertz: impact speeds "
                   "are the approach speeds at the first sample in contact, not integrated back to touch")
-        model = self.scene.effects.contact_heat
+        models = self.scene.effects.heat_models
+        model = models[0] if models else "none"
         moved = e = t_coll = np.zeros(len(rows))
+        side = {}
         if self.heat:
-            G, e, t_coll = evaluate(model, self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0,
-                                    np.ones(len(rows)))                        # Q per kelvin [J/K]
+            args = (self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0, np.ones(len(rows)))
+            G, e, t_coll = evaluate(model, *args)                               # Q per kelvin [J/K]
+            if len(models) > 1:         # side columns: the same collisions at the same dT, nothing moved
+                dT = temperature_difference(atoms.T, i, jl, self.T_wall)
+                side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}
             moved, capped, from_walls = exchange_heat(atoms.T, self.C, i, jl, G, self.T_wall)
             self.totals["capped"] += capped
             self.totals["heat_from_walls"] += from_walls
             self.totals["heat_moved"] += float(np.abs(moved[~wall]).sum())
+            by_model = self.heat_by_model()
+            for m, q in zip(models, [moved] + list(side.values())):
+                by_model[m] += float(np.abs(q[~wall]).sum())
         normal = c.normal[rows]
         for k, key in enumerate(keys[rows]):
             self.open[int(key)] = (self.t, t_coll[k], e[k], v0[k], normal[k])
@@ -306,7 +324,12 @@ class Coupling:
         self.collisions.write_columns(time=np.full(len(rows), self.t), i=c.i[rows],
                                       j=np.where(wall, 0, c.j[rows]),
                                       wall=np.where(wall, c.j[rows] - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
-                                      t_coll=t_coll, model=np.full(len(rows), model))
+                                      t_coll=t_coll, model=np.full(len(rows), model), **side)
+
+    def heat_by_model(self) -> dict:
+        """Heat between particles [J], sum of |Q| over collisions, of each heat model: the one
+        that moved it and the side models on the same collisions."""
+        return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
 
     def end_collisions(self, atoms, closed) -> None:
         info = [self.open.pop(int(k)) for k in closed]
@@ -440,6 +463,7 @@ class Coupling:
 
     def finish(self, status: str = "completed") -> dict:
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
+        self.heat_by_model()
         summary = dict(self.totals, status=status, time=self.t, steps=self.steps, groups=self.group_names)
         if self.heat:
             atoms = self.dem.atoms(True)
@@ -486,6 +510,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, **particles)
+                coupling.start()
                 max_steps = None if max_time is None else round(max_time / dem.dt)
             n = dem.steps(run.steps, run.upto)
             if max_steps is not None:

@@ -30,8 +30,14 @@ def plot_history(out: Path) -> Path:
     ax2.set_xlabel("time [ms]")
     ax2.set_ylabel("collisions so far")
     ax2.grid(alpha=0.3)
+    return _save(fig, out / "temperatures.png")
+
+
+def _save(fig, path: Path) -> Path:
+    """Tight layout, 100 dpi, figure closed (pictures are drawn in batches)."""
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
-    path = out / "temperatures.png"
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
@@ -141,3 +147,36 @@ def _fluid_box(out: Path):
     box = list(scene["domain"]["box"])
     box[4] -= (scene.get("fluid") or {}).get("plenum", 0.0)
     return box
+
+
+def plot_post(out: Path, last, pair_names, times, pair_heat) -> Path:
+    """Offline heat of a dump folder -> out/post.png. Left: the last frame seen from the front
+    (x, z), each particle coloured by its temperature change since the start, on a scale
+    symmetric about zero and only as wide as the largest change, in mK when below 1 K (a
+    collision moves little heat: a scale over the temperatures themselves would show none).
+    Right: heat moved per pair of atom types ("1-wall": type 1 with walls) against time.
+    ``last`` = (time [s], positions (n, 3) [m], temperature change (n,) [K], model)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t, x, dT, model = last
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
+    span = float(np.abs(dT).max()) if len(dT) else 0.0
+    scale, unit = (1e3, "mK") if span < 1.0 else (1.0, "K")
+    span = span * scale or 1.0
+    dots = ax1.scatter(x[:, 0] * 1e3, x[:, 2] * 1e3, c=dT * scale, cmap="coolwarm", vmin=-span, vmax=span, s=12)
+    fig.colorbar(dots, ax=ax1, label=f"temperature change [{unit}], model {model}")
+    ax1.set_xlabel("x [mm]")
+    ax1.set_ylabel("z [mm]")
+    ax1.set_aspect("equal", adjustable="datalim")
+    ax1.set_title(f"t = {t * 1e3:.4g} ms")
+    heat = np.array(pair_heat).reshape(len(times), len(pair_names))
+    for k, name in enumerate(pair_names):
+        ax2.plot(np.array(times) * 1e3, heat[:, k], label=f"types {name}")
+    ax2.set_xlabel("time [ms]")
+    ax2.set_ylabel(f"heat moved so far, model {model} [J]")
+    if pair_names:
+        ax2.legend()
+    ax2.grid(alpha=0.3)
+    return _save(fig, out / "post.png")

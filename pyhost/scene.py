@@ -10,7 +10,8 @@ Example::
 
     [effects]
     fluid = false                 # OpenFOAM solver process
-    contact_heat = "A"            # none, A, B, C (plugins.heat models)
+    contact_heat = "A"            # none, A, B, C, or a comparison model (hertz, softened, ...);
+                                  # or a list: ["A", "B", "C", "softened"], the first moves heat
     heat_path = "fast"            # exact, fast
     restitution_feedback = false  # e(v0) of the model applied at contact end
     enduring_conduction = false   # conduction through contacts that outlast a collision
@@ -50,7 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from plugins.convection import CORRELATIONS
-from plugins.heat import MODELS
+from plugins.heat import MODEL_NAMES, MODELS
 
 
 class SceneError(ValueError):
@@ -67,6 +68,13 @@ def _check(value, rule: str) -> str | None:
         return f"must be in (0, 1], got {value!r}"
     if rule == "poisson" and not -1 < value < 0.5:
         return f"must be in (-1, 0.5), got {value!r}"
+    if rule == "models":
+        names = [value] if isinstance(value, str) else value
+        choices = ("none",) + MODEL_NAMES if isinstance(value, str) else MODEL_NAMES
+        if not names or not all(isinstance(n, str) and n in choices for n in names):
+            return f"must be one of {', '.join(choices)}, or a list of models, got {value!r}"
+        if len(set(names)) != len(names):
+            return f"names a model twice: {value!r}"
     if rule.startswith("in:") and value not in rule[3:].split(","):
         return f"must be one of {rule[3:].replace(',', ', ')}, got {value!r}"
     return None
@@ -82,7 +90,8 @@ def spec(rule: str = "", default=dataclasses.MISSING, doc: str = ""):
 @dataclass(frozen=True)
 class Effects:
     fluid: bool = spec(default=False, doc="run the OpenFOAM fluid solver")
-    contact_heat: str = spec("in:none," + ",".join(sorted(MODELS)), "none", "collision heat model")
+    contact_heat: str | list = spec("models", "none", "collision heat model, or a list of models: the first "
+                                    "moves the temperatures (and gives e), the others are side columns")
     heat_path: str = spec("in:exact,fast", "fast", "plugin evaluation path")
     restitution_feedback: bool = spec(default=False, doc="apply the model's e(v0) at contact end")
     enduring_conduction: bool = spec(default=False, doc="box scenes: LIGGGHTS' fix heat/gran conducts through "
@@ -91,6 +100,13 @@ class Effects:
     convection: str = spec("in:none," + ",".join(sorted(CORRELATIONS)), "none",
                            "gas-particle convection: Nusselt correlation (plugins.convection); turns on the "
                            "gas energy equation of the fluid")
+
+    @property
+    def heat_models(self) -> tuple:
+        """The collision heat models, the one that moves heat first; () for none."""
+        if isinstance(self.contact_heat, str):
+            return () if self.contact_heat == "none" else (self.contact_heat,)
+        return tuple(self.contact_heat)
 
 
 @dataclass(frozen=True)
@@ -229,7 +245,7 @@ class Scene:
 
     def effects_summary(self) -> dict:
         """What the host builds for this scene."""
-        heat = self.effects.contact_heat != "none"
+        heat = bool(self.effects.heat_models)
         convection = self.effects.convection != "none"
         return dict(
             fluid_solver=self.effects.fluid,
@@ -265,7 +281,7 @@ def _build(cls, data, where: str, file: str):
         if kind is float and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         if not isinstance(value, kind) or (kind is not bool and isinstance(value, bool)):
-            raise SceneError(f"{file}: {key}: must be {kind.__name__}, got {value!r}")
+            raise SceneError(f"{file}: {key}: must be {getattr(kind, '__name__', str(kind))}, got {value!r}")
         if kind is float and not math.isfinite(value):
             raise SceneError(f"{file}: {key}: must be finite, got {value!r}")
         problem = _check(value, f.metadata.get("rule", "")) if f.metadata.get("rule") else None
@@ -300,17 +316,23 @@ def _inlet_table(fluid, file):
 SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output", "dem")
 
 
+def read_toml(path) -> dict:
+    """The tables of a scene file; SceneError if it is missing, not text or not TOML."""
+    from pyhost.validate import read_text
+    try:
+        return tomllib.loads(read_text(Path(path)))
+    except FileNotFoundError:
+        raise SceneError(f"{path}: no such scene file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+
+
 def load_scene(path) -> Scene:
     """Read and validate a scene file; raises SceneError naming the file and the key."""
-    from pyhost.validate import check_raw, check_scene, read_text
+    from pyhost.validate import check_raw, check_scene
     path = Path(path)
     file = str(path)
-    try:
-        data = tomllib.loads(read_text(path))
-    except FileNotFoundError:
-        raise SceneError(f"{file}: no such scene file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{file}: not valid TOML: {exc}") from None
+    data = read_toml(path)
     for key in data:
         if key not in SECTIONS:
             raise SceneError(f"{file}: {key}: unknown section; known: {', '.join(SECTIONS)}")
@@ -354,8 +376,9 @@ def load_scene(path) -> Scene:
         if time.dem_step >= time.end:
             raise SceneError(f"{file}: time.dem_step: must be below time.end ({time.end}), got {time.dem_step}")
     fluid = _build(Fluid, data["fluid"], "fluid", file) if "fluid" in data else None
-    if effects.restitution_feedback and effects.contact_heat == "none":
-        raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model in effects.contact_heat")
+    if effects.restitution_feedback and (not effects.heat_models or effects.heat_models[0] not in MODELS):
+        raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model ({', '.join(sorted(MODELS))}) "
+                         f"first in effects.contact_heat; comparison models give no restitution")
     if effects.fluid and fluid is None:
         raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
     if effects.convection != "none" and not effects.fluid:

@@ -15,6 +15,8 @@ import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from pyhost.dumps import LOCAL_DEFAULT, LOCAL_GROUPS
+
 REFUSED = {
     "jump": "loops and jumps need LIGGGHTS' own input loop",
     "label": "loops and jumps need LIGGGHTS' own input loop",
@@ -22,14 +24,6 @@ REFUSED = {
     "quit": "the host ends the run itself",
     "shell": "the host does not run shell commands for a script",
 }
-
-# compute pair/gran/local and wall/gran/local: LIGGGHTS writes the keywords' groups in this
-# order whatever order they are typed in (compute_pair_gran_local.cpp, init_cpgl), heatFlux last.
-LOCAL_GROUPS = (("pos", 6), ("vel", 6), ("id", 3), ("force", 3), ("force_normal", 3),
-                ("force_tangential", 3), ("torque", 3), ("history", None), ("contactArea", 1),
-                ("delta", 1), ("heatFlux", 1))
-LOCAL_DEFAULT = ("pos", "vel", "id", "force", "torque", "history", "contactArea")
-
 
 class ScriptError(ValueError):
     """A script the host cannot run, naming the file and the line."""
@@ -177,26 +171,20 @@ def parse_wall(cmd: Command) -> GranWall | None:
     raise ScriptError(f"{cmd.where()}: fix wall/gran with neither 'primitive' nor 'meshes'")
 
 
-def local_columns(keywords: list[str], total: int | None = None) -> dict:
-    """Column slices of a ``compute pair/gran/local`` (or wall/gran/local) with these keywords,
-    in LIGGGHTS' code order. ``history`` has as many columns as the pair style keeps; it is
-    found from ``total``, the compute's column count."""
-    keywords = list(keywords) or list(LOCAL_DEFAULT)
-    unknown = [k for k in keywords if k not in dict(LOCAL_GROUPS)]
-    if unknown:
-        raise ScriptError(f"unknown pair/gran/local keyword(s) {unknown}")
-    fixed = sum(n for k, n in LOCAL_GROUPS if k in keywords and n is not None)
+def local_columns(keywords: list[str], total: int) -> dict:
+    """Column slice of each keyword group of a ``compute pair/gran/local`` (or wall/gran/local)
+    with these keywords, in LIGGGHTS' code order (``pyhost.dumps.LOCAL_GROUPS``, the one table
+    of that order). ``history`` has as many columns as the pair style keeps: found from
+    ``total``, the compute's column count."""
+    words = [k for k in keywords if k in LOCAL_GROUPS] or list(LOCAL_DEFAULT)
+    widths = {k: sum(n or 0 for _, n in LOCAL_GROUPS[k][0]) for k in words}
+    if "history" in words:
+        widths["history"] = total - sum(widths.values())
     cols, at = {}, 0
-    for key, n in LOCAL_GROUPS:
-        if key not in keywords:
-            continue
-        if n is None:
-            if total is None:
-                raise ScriptError("the column count of a compute with 'history' is needed to lay out its columns")
-            n = total - fixed
-        cols[key] = slice(at, at + n)
-        at += n
-    if total is not None and at != total:
+    for key in (k for k in LOCAL_GROUPS if k in words):
+        cols[key] = slice(at, at + widths[key])
+        at += widths[key]
+    if at != total:
         raise ScriptError(f"a compute with keywords {' '.join(keywords)} has {at} columns, LIGGGHTS gave {total}")
     return cols
 
@@ -215,12 +203,12 @@ class ScriptInfo:
     globals: dict = field(default_factory=dict)         # property/global name -> fix id
     periodic: tuple = (False, False, False)             # from the boundary command
 
-    def wall_type(self, fix: str) -> int | None:
-        """The LIGGGHTS atom type of a wall fix (its primitive's, or its first mesh's)."""
+    def wall_type(self, fix: str, mesh: int = 0) -> int | None:
+        """The LIGGGHTS atom type of a wall fix's primitive, or of its mesh number ``mesh``."""
         wall = self.walls.get(fix)
         if wall is None:
             return None
-        return wall.type if wall.primitive is not None else self.mesh_types.get(wall.meshes[0] if wall.meshes else "")
+        return wall.type if wall.primitive is not None else self.mesh_types.get(wall.meshes[mesh])
 
     def learn(self, cmd: Command) -> None:
         w = cmd.words

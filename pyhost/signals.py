@@ -27,10 +27,21 @@ class Interrupted(BaseException):
         return 128 + self.signum
 
 
+_received: list[int] = []
+
+
+def check() -> None:
+    """Raise :class:`Interrupted` again if a signal came: an exception raised by a handler can
+    be swallowed where Python ignores exceptions (e.g. in os.fork's after-fork hooks), so the
+    coupling loop asks once per chunk."""
+    if _received:
+        raise Interrupted(_received[0])
+
+
 @contextlib.contextmanager
 def stopping():
     """Turn the first of SIGINT, SIGTERM, SIGHUP into :class:`Interrupted`; ignore the rest."""
-    first = []
+    first = _received
 
     def handler(signum, frame):
         if not first:
@@ -43,3 +54,4 @@ def stopping():
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+        first.clear()

@@ -14,6 +14,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from plugins.heat import MODEL_NAMES  # noqa: E402
 from pyhost import scene as S  # noqa: E402
 
 SECTIONS = (
@@ -50,8 +51,10 @@ def page() -> str:
         lines += [f"## {title}", "", text, "", "| key | type | default | meaning |", "|---|---|---|---|"]
         for f in dataclasses.fields(cls):
             kind = hints[f.name]
-            name = kind.__name__ if isinstance(kind, type) else str(kind)
+            name = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in typing.get_args(kind))
             rule = f.metadata.get("rule", "")
+            if rule == "models":
+                rule = "in:none," + ",".join(MODEL_NAMES)
             doc = f.metadata.get("doc", "") + (f" ({rule.replace('in:', 'one of: ').replace(',', ', ')})"
                                                if rule.startswith("in:") else f" ({rule})" if rule else "")
             lines.append(f"| `{f.name}` | {name} | {default(f)} | {doc.strip()} |")

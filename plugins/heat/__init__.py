@@ -4,10 +4,15 @@
 Public API (SI units throughout):
 - ``Pair`` (and ``Pair.wall``): the two bodies; ``PAPER_SET`` the paper's parameters;
 - ``collide(v0, pair, model)``: one collision by the exact path -> ``Collision``;
-- ``MODELS`` / ``get_model``: the registry of contact models "A", "B", "C".
+- ``MODELS`` / ``get_model``: the registry of contact models "A", "B", "C";
+- ``plugins.heat.comparison.COMPARISON``: the comparison models (hertz, softened, ...);
+  ``MODEL_NAMES`` every registered name of both.
 """
 from plugins.heat.exact import Collision, collide
 from plugins.heat.models import MODELS, get_model
 from plugins.heat.pair import PAPER_SET, Pair, effective_modulus
+from plugins.heat.comparison import COMPARISON
 
-__all__ = ["Collision", "collide", "MODELS", "get_model", "PAPER_SET", "Pair", "effective_modulus"]
+MODEL_NAMES = tuple(sorted(MODELS)) + tuple(sorted(COMPARISON))
+
+__all__ = ["Collision", "collide", "MODELS", "get_model", "PAPER_SET", "Pair", "effective_modulus", "MODEL_NAMES"]

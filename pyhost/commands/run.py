@@ -117,7 +117,7 @@ def user_script(scene):
             if w.fix not in known:
                 raise SceneError(f"{scene.path}: walls[{k}].fix: the script has no fix wall/gran {w.fix!r} "
                                  f"before its first run; its walls: {', '.join(known) or 'none'}")
-            named[w.fix] = HostWall(w.fix, names.index(w.material), w.temperature if w.temperature > 0 else np.nan)
+            named[w.fix] = (names.index(w.material), w.temperature if w.temperature > 0 else np.nan)
         for fix in known:
             if fix not in named:
                 print(f"LIGGGHTS wall {fix!r} has no [[walls]] entry: adiabatic for collision heat")
@@ -125,7 +125,8 @@ def user_script(scene):
         if len(mesh) > 1:
             print(f"warning: LIGGGHTS lists the contacts of one mesh wall fix only ({mesh[-1]!r}); "
                   f"collisions with {', '.join(mesh[:-1])} are not seen")
-        return [named.get(f, HostWall(f, -1, np.nan)) for f in known]
+        return [HostWall(f, *named.get(f, (-1, np.nan)), mesh=k)
+                for f, wall in known.items() for k in range(max(len(wall.meshes), 1))]
 
     return dict(type_material=type_material,
                 groups=(names, lambda atoms: type_material[np.minimum(atoms.type, top)]),

@@ -5,9 +5,9 @@ A model pairs a compression law (``plugins.heat.compression``) with a recovery l
 """
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from dataclasses import dataclass
+
+from plugins.heat.registry import collect, lookup
 
 
 @dataclass(frozen=True)
@@ -20,15 +20,9 @@ class Model:
     description: str
 
 
-MODELS: dict[str, Model] = {
-    info.name: importlib.import_module(f"{__name__}.{info.name}").MODEL
-    for info in pkgutil.iter_modules(__path__)
-}
+MODELS: dict[str, Model] = collect(__name__, __path__)
 
 
 def get_model(name: str) -> Model:
     """The model registered as ``name``; an unknown name raises ValueError with the choices."""
-    try:
-        return MODELS[name]
-    except KeyError:
-        raise ValueError(f"unknown contact model {name!r}; choices: {', '.join(sorted(MODELS))}") from None
+    return lookup(MODELS, name, "contact model")

@@ -1,0 +1,45 @@
+"""``python -m pyhost post DUMP... --scene SCENE.toml``: collision heat of a finished LIGGGHTS
+run from its dump files, by the Kosinski et al. models (pyhost/post.py)."""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+HELP = "collision heat of a finished LIGGGHTS run from its dump files (models A, B, C)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("dumps", nargs="+", help="particle dumps (dump custom, gzipped or not, or custom/vtk); "
+                                            "wildcards such as 'post/dump.*' are expanded")
+    p.add_argument("--scene", type=Path, required=True,
+                   help="TOML with [materials.NAME] (types = [...], temperature) and [[walls]] (fix or plane)")
+    p.add_argument("--contacts", nargs="+", default=[], metavar="DUMP",
+                   help="dump local files of compute pair/gran/local and wall/gran/local")
+    p.add_argument("--script", type=Path, help="the LIGGGHTS input that wrote the dumps (timestep, computes, "
+                                               "mesh wall fixes)")
+    p.add_argument("--compute", action="append", default=[], metavar="'ID STYLE KEYWORDS'",
+                   help="a contact compute's keywords when there is no script, e.g. 'cp pair/gran/local pos vel id'")
+    p.add_argument("--model", choices=("A", "B", "C", "all"), default="all", help="contact heat model")
+    p.add_argument("--out", type=Path, default=Path("collheat-post"), help="output folder")
+    p.add_argument("--dt", type=float, help="DEM time step [s] (default: the script's timestep)")
+    p.add_argument("--skip-bad-frames", action="store_true", help="warn about a bad frame, skip it and go on")
+
+
+def run(args) -> int:
+    from pyhost.dumps import parse_compute, read_script
+    from pyhost.post import MODELS, Post, load_post_scene
+
+    scene = load_post_scene(args.scene)
+    script = read_script(args.script) if args.script else None
+    computes = {c.id: c for c in (parse_compute(text, "--compute: ") for text in args.compute)}
+    if args.dt is not None and not args.dt > 0:
+        raise ValueError(f"--dt: must be > 0, got {args.dt}")
+    post = Post(args.dumps, scene, args.out, contacts=args.contacts, script=script, computes=computes,
+                models=MODELS if args.model == "all" else (args.model,), dt=args.dt,
+                skip_bad_frames=args.skip_bad_frames)
+    summary = post.run()
+    for w in summary["warnings"]:
+        print("warning:", w)
+    print("summary:", json.dumps({k: v for k, v in summary.items() if k != "warnings"}, indent=1))
+    return 0

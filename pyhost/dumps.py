@@ -1,0 +1,579 @@
+"""Streaming reader of LIGGGHTS (and LAMMPS) dump files, frame by frame, in bounded memory.
+
+Reads ``dump custom`` and ``dump atom`` text (``ITEM: ATOMS`` with any column order),
+``dump local`` (``ITEM: ENTRIES``) of ``compute pair/gran/local`` and ``wall/gran/local``,
+and ``dump custom/vtk`` legacy VTK files (through pyvista). Text files may be gzipped (told by
+their first bytes, not their name); one file may hold many steps, or each step its own file.
+Files are read in the order of their first timestep, not of their names (``dump.1000`` sorts
+before ``dump.500`` by name).
+
+``DumpReader(paths, ...)`` yields ``Frame``s: one numpy array of the frame's rows (parsed by
+numpy's C loader, never row by row in Python), the box and its periodicity from
+``ITEM: BOX BOUNDS``, and the column names. ``frame["radius"]``, ``frame["f_Temp"]`` (which also
+finds ``f_Temp[0]``), ``frame.positions()`` (x y z, unwrapped or scaled), ``frame.vector("v")``.
+
+A local dump's header names its columns only ``c_ID[k]``. What column k of compute ID holds
+comes from the compute's keywords (``Compute``, e.g. from ``read_script`` of the LIGGGHTS input
+that wrote the dumps): LIGGGHTS writes the keywords' groups in its code order, whatever order
+they were typed in (``LOCAL_GROUPS``; measured in ../shared/ENGINES.md and read from
+``compute_pair_gran_local.h`` of LIGGGHTS 3.8). A column that cannot be placed for sure is an
+error, never a guess.
+
+Any problem is a ``DumpError`` naming the file, the frame's timestep, the line and the problem.
+With ``skip_bad_frames`` the reader records a warning (``reader.warnings``), skips the frame and
+goes on from the next ``ITEM: TIMESTEP``.
+"""
+from __future__ import annotations
+
+import glob
+import gzip
+import re
+import shlex
+import zlib
+from dataclasses import dataclass, field
+from itertools import islice
+from pathlib import Path
+
+import numpy as np
+
+
+class DumpError(ValueError):
+    """A problem in a dump file: file, timestep of the frame (None before the first), line, problem."""
+
+    def __init__(self, file, step, line, problem: str):
+        self.file, self.step, self.line, self.problem = str(file), step, line, problem
+        where = f"{file}: line {line}" if line else f"{file}"
+        super().__init__(f"{where}: timestep {'?' if step is None else step}: {problem}")
+
+
+# compute pair/gran/local and wall/gran/local of LIGGGHTS 3.8: keyword -> its columns (name,
+# width), pair then wall, in the order LIGGGHTS writes them. "history" has the width of the pair
+# style's history (unknown here). heatFlux is written last whatever else is asked for.
+LOCAL_GROUPS = {
+    "pos": ((("x_i", 3), ("x_j", 3)), (("x_contact", 3), ("x_i", 3))),
+    "vel": ((("v_i", 3), ("v_j", 3)), (("v_wall", 3), ("v_i", 3))),
+    "id": ((("id_i", 1), ("id_j", 1), ("periodic", 1)), (("mesh", 1), ("triangle", 1), ("id_i", 1))),
+    "force": ((("force", 3),),) * 2,
+    "force_normal": ((("force_normal", 3),),) * 2,
+    "force_tangential": ((("force_tangential", 3),),) * 2,
+    "torque": ((("torque", 3),),) * 2,
+    "torque_normal": ((("torque_normal", 3),),) * 2,
+    "torque_tangential": ((("torque_tangential", 3),),) * 2,
+    "history": ((("history", None),),) * 2,
+    "contactArea": ((("contact_area", 1),),) * 2,
+    "delta": ((("delta", 1),),) * 2,
+    "contactPoint": ((("contact_point", 3),),) * 2,
+    "heatFlux": ((("heat_flux", 1),),) * 2,
+}
+LOCAL_DEFAULT = ("pos", "vel", "id", "force", "torque", "history", "contactArea")   # no keyword given
+LOCAL_OPTIONS = {"verbose": 0, "extraSurfDistance": 1}      # keywords that add no column: values taken
+LOCAL_STYLES = ("pair/gran/local", "wall/gran/local")
+
+
+@dataclass(frozen=True)
+class Compute:
+    """A LIGGGHTS ``compute ID group STYLE keywords...`` of a local style."""
+
+    id: str
+    style: str
+    keywords: tuple = ()
+
+    @property
+    def wall(self) -> bool:
+        return self.style == "wall/gran/local"
+
+    def columns(self) -> list:
+        """(name, component) of each column the compute writes, in LIGGGHTS' order; a name
+        of None stands for columns of unknown width (history), after which nothing is known."""
+        words = [w for w in self.keywords if w in LOCAL_GROUPS] or list(LOCAL_DEFAULT)
+        cols = []
+        for kw in [k for k in LOCAL_GROUPS if k in words]:
+            for name, width in LOCAL_GROUPS[kw][self.wall]:
+                if width is None:
+                    return cols + [(None, None)]
+                cols += [(name, c) for c in range(width)] if width > 1 else [(name, None)]
+        return cols
+
+
+def parse_compute(text: str, where: str = "") -> Compute:
+    """A compute from ``ID STYLE keywords...`` (or a whole ``compute ID group STYLE ...`` line)."""
+    words = shlex.split(text.split("#")[0])
+    if words and words[0] == "compute":
+        words = words[1:2] + words[3:]
+    if len(words) < 2 or words[1] not in LOCAL_STYLES:
+        raise ValueError(f"{where}compute {text!r}: expected 'ID STYLE keyword...' with STYLE "
+                         f"{' or '.join(LOCAL_STYLES)}")
+    keywords, rest = [], iter(words[2:])
+    for w in rest:
+        if w in LOCAL_OPTIONS:
+            list(islice(rest, LOCAL_OPTIONS[w]))
+        elif w in LOCAL_GROUPS:
+            keywords.append(w)
+        else:
+            raise ValueError(f"{where}compute {words[0]}: keyword {w!r} not understood; known: "
+                             f"{', '.join(LOCAL_GROUPS)}")
+    return Compute(words[0], words[1], tuple(keywords))
+
+
+@dataclass(frozen=True)
+class Script:
+    """What post-processing needs from the LIGGGHTS input that wrote the dumps."""
+
+    timestep: float | None
+    computes: dict                  # id -> Compute (local styles only)
+    mesh_wall_fixes: tuple          # ids of wall/gran fixes with meshes, in script order
+    warnings: tuple = ()
+
+
+def read_script(path) -> Script:
+    """Reads ``timestep``, the local computes and the mesh wall fixes of a LIGGGHTS input
+    (``&`` continuations and ``#`` comments handled; ``include`` is not followed)."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read the LIGGGHTS script: {exc.strerror}") from None
+    timestep, computes, walls, warnings = None, {}, [], []
+    text = re.sub(r"&[ \t]*\n", " ", text)
+    for number, line in enumerate(text.splitlines(), start=1):
+        words = line.split("#")[0].split()
+        if not words:
+            continue
+        where = f"{path}: line {number}: "
+        if words[0] == "timestep" and len(words) > 1:
+            try:
+                timestep = float(words[1])
+            except ValueError:
+                timestep = None
+                warnings.append(f"{where}timestep {words[1]!r} is not a number: give --dt")
+        elif words[0] == "compute" and len(words) > 3 and words[3] in LOCAL_STYLES:
+            c = parse_compute(line, where)
+            computes[c.id] = c
+        elif words[0] == "fix" and len(words) > 3 and words[3] == "wall/gran" and "mesh" in words:
+            walls.append(words[1])
+        elif words[0] == "include":
+            warnings.append(f"{where}include {' '.join(words[1:])} not followed")
+    return Script(timestep, computes, tuple(walls), tuple(warnings))
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """One dump frame: rows ``data`` (n, columns) of float64, named by ``columns``."""
+
+    file: str
+    line: int                       # line of its ITEM: TIMESTEP (0 for VTK)
+    step: int
+    time: float | None              # step * dt [s], None without dt
+    box: np.ndarray | None          # (3, 2) lo hi [m]; None for VTK (no box in the file)
+    periodic: tuple                 # (bool, bool, bool)
+    columns: tuple
+    data: np.ndarray
+    kind: str = "atoms"             # atoms, pair, wall, local
+    groups: dict = field(default_factory=dict)     # name -> column indices of a group (local)
+
+    def __len__(self) -> int:
+        return len(self.data)
+
+    def index(self, name: str):
+        """Column index (int) or indices (list) of name; None if absent. ``f_X`` finds ``f_X[0]``."""
+        if name in self.groups:
+            return self.groups[name]
+        for candidate in (name, f"{name}[0]", name[:-3] if name.endswith("[0]") else None):
+            if candidate in self.columns:
+                return self.columns.index(candidate)
+        return None
+
+    def __contains__(self, name: str) -> bool:
+        return self.index(name) is not None
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        k = self.index(name)
+        if k is None and not len(self.data):       # a frame without rows (a VTK file of 0 points has no names)
+            return np.empty((0, 3) if name in self.groups else 0)
+        if k is None:
+            raise KeyError(f"{self.file}: timestep {self.step}: no column {name!r}; columns: {' '.join(self.columns)}")
+        return self.data[:, k]
+
+    def vector(self, name: str) -> np.ndarray:
+        """(n, 3) of group name (local), or of columns name+x, name+y, name+z (vx vy vz)."""
+        if name in self.groups:
+            return self.data[:, self.groups[name]]
+        return np.stack([self[name + c] for c in "xyz"], axis=1)
+
+    def positions(self) -> np.ndarray:
+        """(n, 3) centres [m] from x y z, xu yu zu, or the scaled xs ys zs / xsu ysu zsu."""
+        if not len(self.data):
+            return np.empty((0, 3))
+        for suffix in ("", "u"):
+            if all(c + suffix in self.columns for c in "xyz"):
+                return np.stack([self[c + suffix] for c in "xyz"], axis=1)
+            if all(c + "s" + suffix in self.columns for c in "xyz"):
+                s = np.stack([self[c + "s" + suffix] for c in "xyz"], axis=1)
+                return self.box[:, 0] + s * (self.box[:, 1] - self.box[:, 0])
+        raise KeyError(f"{self.file}: timestep {self.step}: no positions (x y z, xu.., xs..)")
+
+
+POSITION_SETS = ("x y z", "xu yu zu", "xs ys zs", "xsu ysu zsu")
+REQUIRED = {"id": ("id",), "type": ("type",), "position": POSITION_SETS, "velocity": ("vx vy vz",),
+            "radius": ("radius",)}
+"""Columns post-processing needs, each satisfied by any of the column sets listed."""
+
+
+def _missing(columns, require) -> list:
+    have = set(columns)
+    return [name for name in require
+            if not any(set(option.split()) <= have for option in REQUIRED[name])]
+
+
+def open_text(path: Path):
+    """Text stream of a plain or gzipped file (gzip told by its magic bytes)."""
+    with open(path, "rb") as f:
+        magic = f.read(2)
+    if magic == b"\x1f\x8b":
+        return gzip.open(path, "rt", encoding="ascii", errors="strict")
+    return open(path, encoding="ascii", errors="strict")
+
+
+STREAM_ERRORS = (EOFError, gzip.BadGzipFile, zlib.error, UnicodeDecodeError, OSError)
+
+
+class _Lines:
+    """Lines of an open file with their 1-based numbers and a pushback for resynchronising."""
+
+    def __init__(self, stream):
+        self.stream, self.number, self.back = stream, 0, []
+
+    def next(self) -> str | None:
+        self.number += 1
+        if self.back:
+            return self.back.pop()
+        line = self.stream.readline()
+        if not line:
+            self.number -= 1
+            return None
+        return line
+
+    def take(self, n: int) -> list:
+        lines = []
+        while self.back and len(lines) < n:
+            lines.append(self.back.pop())
+        lines += islice(self.stream, n - len(lines))
+        self.number += len(lines)
+        return lines
+
+    def push(self, lines: list) -> None:
+        self.back.extend(reversed(lines))
+        self.number -= len(lines)
+
+
+VTK_SUFFIXES = (".vtk", ".vtp", ".vtu")
+
+
+def expand(paths) -> list:
+    """Paths with shell wildcards expanded (for quoted ``'post/dump.*'``)."""
+    out = []
+    for p in map(str, paths):
+        hits = sorted(glob.glob(p)) if glob.has_magic(p) else [p]
+        if not hits:
+            raise DumpError(p, None, 0, "no file matches")
+        for h in hits:
+            if not Path(h).is_file():
+                raise DumpError(h, None, 0, "no such file")
+        out += hits
+    return [Path(h) for h in out]
+
+
+def _vtk_step(path: Path) -> int:
+    digits = re.findall(r"\d+", path.name[: -len(path.suffix)])
+    if not digits:
+        raise DumpError(path, None, 0, "a VTK dump's timestep is read from its name, and this one has no number")
+    return int(digits[-1])
+
+
+class DumpReader:
+    """Frames of dump files in timestep order: ``for frame in DumpReader(paths): ...``.
+
+    ``computes``: id -> Compute for local dumps (``read_script(...).computes``); ``dt`` [s]
+    gives each frame its time; ``require``: names of ``REQUIRED`` an atom frame must hold;
+    ``skip_bad_frames``: warn (``self.warnings``) and go on instead of raising.
+    """
+
+    def __init__(self, paths, computes: dict | None = None, dt: float | None = None, require=(),
+                 skip_bad_frames: bool = False):
+        self.computes, self.dt, self.require = dict(computes or {}), dt, tuple(require)
+        self.skip, self.warnings = skip_bad_frames, []
+        files = expand(paths)
+        boxes = [p for p in files if p.suffix.lower() in VTK_SUFFIXES and "_boundingBox_" in p.name]
+        if boxes:
+            self.warnings.append(f"{len(boxes)} box outlines of dump custom/vtk (*_boundingBox_*) not read "
+                                 "as particle frames")
+        self.files = self._order([p for p in files if p not in boxes])
+
+    def _fail(self, error: DumpError) -> None:
+        if not self.skip:
+            raise error
+        self.warnings.append(f"skipped: {error}")
+
+    def _first_step(self, path: Path):
+        if path.suffix.lower() in VTK_SUFFIXES:
+            return _vtk_step(path)
+        try:
+            with open_text(path) as f:
+                head = [f.readline() for _ in range(2)]
+        except STREAM_ERRORS as exc:
+            raise DumpError(path, None, 1, f"unreadable ({type(exc).__name__}: {exc})") from None
+        if not head[0]:
+            raise DumpError(path, None, 0, "empty file")
+        if head[0].strip() != "ITEM: TIMESTEP":
+            raise DumpError(path, None, 1, f"not a LIGGGHTS dump: first line {head[0].strip()[:60]!r}, "
+                                           "expected 'ITEM: TIMESTEP'")
+        try:
+            return int(head[1])
+        except ValueError:
+            raise DumpError(path, None, 2, f"timestep {head[1].strip()[:40]!r} is not an integer") from None
+
+    def _order(self, paths) -> list:
+        keyed = []
+        for p in paths:
+            try:
+                keyed.append((self._first_step(p), str(p), p))
+            except DumpError as exc:
+                self._fail(exc)
+        return [p for _, _, p in sorted(keyed)]
+
+    def __iter__(self):
+        last = None                                     # (step, file) of the previous frame
+        for path in self.files:
+            frames = self._vtk(path) if path.suffix.lower() in VTK_SUFFIXES else self._text(path)
+            for frame in frames:
+                if last is not None and frame.step < last[0]:
+                    self._fail(DumpError(frame.file, frame.step, frame.line,
+                                         f"timestep goes backwards (previous frame: timestep {last[0]} in {last[1]})"))
+                    continue
+                if last is not None and frame.step == last[0]:
+                    self.warnings.append(f"{frame.file}: line {frame.line}: timestep {frame.step} again: "
+                                         "frame skipped")
+                    continue
+                last = (frame.step, frame.file)
+                yield frame
+
+    def _text(self, path: Path):
+        try:
+            stream = open_text(path)
+        except OSError as exc:
+            self._fail(DumpError(path, None, 0, f"cannot open: {exc.strerror}"))
+            return
+        with stream:
+            lines = _Lines(stream)
+            while True:
+                start = lines.number + 1
+                try:
+                    frame = self._frame(lines, path)
+                except DumpError as exc:
+                    self._fail(exc)
+                    if not self._resync(lines, path):
+                        return
+                    continue
+                except STREAM_ERRORS as exc:
+                    self._fail(DumpError(path, None, lines.number + 1, f"truncated or corrupt stream after line "
+                                         f"{lines.number} ({type(exc).__name__}: {exc})"))
+                    return
+                if frame is None:
+                    if lines.number + 1 == start == 1:
+                        self._fail(DumpError(path, None, 0, "empty file"))
+                    return
+                yield frame
+
+    def _resync(self, lines: _Lines, path: Path) -> bool:
+        """After a bad frame: on to the next ITEM: TIMESTEP; False at the end of the file."""
+        try:
+            while (line := lines.next()) is not None:
+                if line.startswith("ITEM: TIMESTEP"):
+                    lines.push([line])
+                    return True
+        except STREAM_ERRORS as exc:
+            self.warnings.append(f"{path}: line {lines.number + 1}: truncated or corrupt stream "
+                                 f"({type(exc).__name__}: {exc}): rest of the file skipped")
+        return False
+
+    def _frame(self, lines: _Lines, path: Path) -> Frame | None:
+        line = lines.next()
+        if line is None:
+            return None
+        start, step = lines.number, None
+
+        def error(problem, number=None):
+            return DumpError(path, step, lines.number if number is None else number, problem)
+
+        def item(expected):
+            text = lines.next()
+            if text is None:
+                raise error(f"file ends where '{expected}' was expected (truncated)", lines.number + 1)
+            if not text.startswith(expected):
+                raise error(f"expected '{expected}', got {text.strip()[:60]!r}")
+            return text[len(expected):].split()
+
+        lines.push([line])
+        item("ITEM: TIMESTEP")
+        step = self._integer(lines, error, "timestep")
+        head = lines.next()
+        if head is None or not head.startswith("ITEM: NUMBER OF "):
+            raise error("expected 'ITEM: NUMBER OF ATOMS' or 'ITEM: NUMBER OF ENTRIES', got "
+                        f"{'end of file' if head is None else repr(head.strip()[:60])}")
+        local = head.strip() == "ITEM: NUMBER OF ENTRIES"
+        n = self._integer(lines, error, "row count")
+        if n < 0:
+            raise error(f"negative row count {n}")
+        flags = item("ITEM: BOX BOUNDS")
+        bounds = flags[-3:]
+        if flags[:3] == ["xy", "xz", "yz"]:
+            raise error("triclinic box: not supported")
+        if len(bounds) != 3 or any(len(b) != 2 or set(b) - set("pfsm") for b in bounds):
+            raise error(f"box boundary flags {' '.join(flags)!r} not understood (expected e.g. 'pp pp ff')")
+        box = np.empty((3, 2))
+        for k in range(3):
+            text = lines.next()
+            try:
+                box[k] = [float(w) for w in (text or "").split()[:2]]
+            except ValueError:
+                raise error(f"box bounds {text.strip()[:60]!r}: two numbers expected") from None
+        columns = item("ITEM: ENTRIES" if local else "ITEM: ATOMS")
+        if not columns:
+            raise error("header names no column")
+        kind, groups = ("atoms", {}) if not local else self._local_layout(columns, error)
+        if kind == "atoms" and self.require and (missing := _missing(columns, self.require)):
+            raise error(f"required column missing: {', '.join(missing)} (columns: {' '.join(columns)})")
+        body = lines.take(n)
+        first = lines.number - len(body) + 1
+        try:
+            data = _parse(body, len(columns), lambda problem, row: error(problem, first + row))
+        except _HeaderInRows as short:
+            lines.push(body[short.row:])
+            raise error(f"frame has {short.row} rows, its header says {n} (truncated)", first + short.row) from None
+        if len(body) < n:
+            raise error(f"file ends after {len(body)} rows of {n} (truncated)", first + len(body))
+        if kind == "atoms":
+            self._check_atoms(data, columns, lambda problem, row: error(problem, first + row))
+        time = None if self.dt is None else step * self.dt
+        periodic = tuple(b == "pp" for b in bounds)
+        return Frame(str(path), start, step, time, box, periodic, tuple(columns), data, kind, groups)
+
+    @staticmethod
+    def _integer(lines, error, what) -> int:
+        text = lines.next()
+        try:
+            return int(text)
+        except (TypeError, ValueError):
+            raise error(f"{what} {'missing' if text is None else repr(text.strip()[:40])}: an integer expected") from None
+
+    def _local_layout(self, columns, error):
+        """Kind (pair, wall, local) and name -> column indices from the computes' keywords."""
+        meaning, styles = [], set()
+        for k, name in enumerate(columns):
+            m = re.fullmatch(r"c_([^\[\]]+)\[(\d+)\]", name)
+            if not m:
+                meaning.append((name, None))
+                continue
+            cid, col = m.group(1), int(m.group(2))
+            if cid not in self.computes:
+                raise error(f"column {name}: what compute {cid}'s columns hold needs its keywords "
+                            f"(--script with its 'compute {cid} ...' line, or --compute '{cid} STYLE keywords')")
+            compute = self.computes[cid]
+            styles.add(compute.style)
+            cols = compute.columns()
+            known = [c for c in cols if c[0] is not None]
+            if col < 1 or (col > len(known) and len(known) == len(cols)):
+                raise error(f"column {name}: compute {cid} ({compute.style} {' '.join(compute.keywords)}) "
+                            f"writes {len(cols)} columns, not {col}: keywords do not match the dump")
+            if col > len(known):
+                raise error(f"column {name}: follows compute {cid}'s 'history', whose width depends on the "
+                            "pair style: its meaning is ambiguous")
+            meaning.append(known[col - 1])
+        if len(styles) > 1:
+            raise error("one dump mixes pair/gran/local and wall/gran/local columns")
+        groups = {}
+        for k, (name, comp) in enumerate(meaning):
+            groups.setdefault(name, {})[comp] = k
+        layout = {name: (parts[None] if None in parts else [parts[c] for c in sorted(parts)])
+                  for name, parts in groups.items() if None in parts or len(parts) == 3}
+        kind = "local" if not styles else ("wall" if styles == {"wall/gran/local"} else "pair")
+        return kind, layout
+
+    def _check_atoms(self, data, columns, error) -> None:
+        if "radius" in columns:
+            bad = np.flatnonzero(data[:, columns.index("radius")] < 0)
+            if len(bad):
+                raise error(f"negative radius {data[bad[0], columns.index('radius')]:g}", bad[0])
+        if "id" in columns:
+            ids = data[:, columns.index("id")]
+            _, first = np.unique(ids, return_index=True)
+            if len(first) < len(ids):
+                row = int(np.setdiff1d(np.arange(len(ids)), first).min())
+                raise error(f"duplicate id {ids[row]:.0f} in one frame", row)
+
+    def _vtk(self, path: Path):
+        import pyvista
+
+        step = _vtk_step(path)
+        try:
+            with pyvista.vtk_verbosity("off"):      # an empty frame (0 points) is no problem here
+                mesh = pyvista.read(str(path))
+        except Exception as exc:          # VTK's reader raises assorted types for broken files
+            self._fail(DumpError(path, step, 0, f"not a readable VTK file ({type(exc).__name__}: {exc})"))
+            return
+        columns, arrays = ["x", "y", "z"], [np.asarray(mesh.points, float)]
+        for name in mesh.point_data.keys():
+            a = np.asarray(mesh.point_data[name], float)
+            if a.ndim == 2 and a.shape[1] == 3:
+                columns += [name + c for c in "xyz"] if name != "v" else ["vx", "vy", "vz"]
+            else:
+                columns.append(name)
+            arrays.append(a.reshape(len(a), -1))
+        data = np.concatenate(arrays, axis=1) if mesh.n_points else np.empty((0, len(columns)))
+        error = lambda problem, row: DumpError(path, step, 0, f"point {row}: {problem}")
+        try:
+            if mesh.n_points and (missing := _missing(columns, self.require)):
+                raise DumpError(path, step, 0, f"required column missing: {', '.join(missing)} "
+                                               f"(point data: {' '.join(mesh.point_data.keys())})")
+            bad = np.flatnonzero(~np.isfinite(data).all(axis=1))
+            if len(bad):
+                raise error("NaN or infinite value", bad[0])
+            self._check_atoms(data, columns, error)
+        except DumpError as exc:
+            self._fail(exc)
+            return
+        time = None if self.dt is None else step * self.dt
+        yield Frame(str(path), 0, step, time, None, (False, False, False), tuple(columns), data)
+
+
+class _HeaderInRows(Exception):
+    def __init__(self, row):
+        self.row = row
+
+
+def _parse(body: list, ncols: int, error) -> np.ndarray:
+    """Rows of numbers (len(body), ncols) by numpy's C parser; on failure the first bad row
+    is found and named (wrong column count, non-numeric token, NaN or infinity), or
+    _HeaderInRows raised where the next frame's header starts among the rows (a short frame)."""
+    if not body:
+        return np.empty((0, ncols))
+    try:
+        data = np.loadtxt(body, dtype=float, comments=None, ndmin=2)
+        if data.shape[1] == ncols and np.isfinite(data).all():
+            return data
+    except ValueError:
+        pass
+    for k, text in enumerate(body):
+        if text.startswith("ITEM:"):
+            raise _HeaderInRows(k)
+        words = text.split()
+        if len(words) != ncols:
+            raise error(f"{len(words)} values in a row, the header names {ncols} columns", k)
+        for w in words:
+            try:
+                value = float(w)
+            except ValueError:
+                raise error(f"non-numeric value {w[:30]!r}", k) from None
+            if not np.isfinite(value):
+                raise error(f"non-finite value {w!r}", k)
+    raise AssertionError("loadtxt refused rows that parse one by one")

@@ -1,0 +1,492 @@
+"""Collision heat of a finished LIGGGHTS run, from its dump files (``python -m pyhost post``).
+
+1. The particle dumps are read once (``pyhost.dumps``): each particle's type and radius by id,
+   its initial temperature (the scene's, else the dump's ``f_Temp`` at its first appearance),
+   and, without contact dumps, the contacts of every frame from positions (periodic images
+   from the box, the scene's plane walls).
+2. With contact dumps (``compute pair/gran/local`` / ``wall/gran/local``), a pair's first
+   appearance is its collision; a particle touching several triangles of one mesh at once is
+   one collision. Its normal impact speed is the approach speed at first appearance, carried
+   back to touch with the DEM's own contact law (``DemHertz.impact_speed``) over the overlap.
+3. Each model gives every collision's heat per kelvin, e and t_coll (``contact_heat.evaluate``);
+   the heat is moved collision by collision, in time order, with the temperatures of that
+   moment (``collisions.exchange_heat``), while the particle dumps are replayed into a VTK
+   series of temperatures and heat received.
+
+Output (``out``): collisions.csv.gz, summary.json, vtk/particles.pvd, post.png. A failure
+keeps what was written before it, and summary.json then says ``"complete": false``.
+"""
+from __future__ import annotations
+
+import csv
+import gzip
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from pyhost.collisions import WALL_BASE, DemHertz, contact_keys, exchange_heat
+from pyhost.contact_heat import evaluate
+from pyhost.contacts import find_contacts
+from pyhost.dem_input import hertz_collision_time
+from pyhost.dumps import STREAM_ERRORS, DumpError, DumpReader, expand, open_text
+from pyhost.output import VtkSeries
+from pyhost.scene import Material, SceneError, Wall, _build, read_toml
+
+PLANES = ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")
+MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
+MODELS = ("A", "B", "C")
+
+
+@dataclass(frozen=True)
+class PostScene:
+    path: Path
+    materials: dict                 # name -> Material (real and DEM values, types, temperature)
+    types: dict                     # LIGGGHTS atom type -> material index
+    temperature: list               # initial temperature per material [K]; 0: from the dumps
+    walls: list                     # pyhost.scene.Wall
+
+
+def load_post_scene(path) -> PostScene:
+    """The ``[materials.NAME]`` (with ``types`` and an optional ``temperature``) and ``[[walls]]``
+    (``fix`` or ``plane``, ``material``, ``temperature``) of a scene file; its other sections
+    belong to runs and are not read here, so a case.toml serves both."""
+    path, file = Path(path), str(path)
+    data = read_toml(path)
+    if not isinstance(data.get("materials"), dict) or not data["materials"]:
+        raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
+    materials = {name: _build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
+    types = {}
+    for k, (name, m) in enumerate(materials.items()):
+        for t in m.types:
+            if not isinstance(t, int) or isinstance(t, bool) or t < 1:
+                raise SceneError(f"{file}: materials.{name}.types: atom types are integers >= 1, got {t!r}")
+            if t in types:
+                raise SceneError(f"{file}: materials.{name}.types: type {t} is also in "
+                                 f"materials.{list(materials)[types[t]]}")
+            types[t] = k
+    if not types:
+        raise SceneError(f"{file}: materials: no material names its LIGGGHTS atom types (types = [1, 2])")
+    if not isinstance(data.get("walls", []), list):
+        raise SceneError(f"{file}: walls: must be [[walls]] tables")
+    walls = [_build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+    for k, wall in enumerate(walls):
+        if wall.material not in materials:
+            raise SceneError(f"{file}: walls[{k}].material: unknown material {wall.material!r}; "
+                             f"known: {', '.join(materials)}")
+        if bool(wall.fix) == bool(wall.plane):
+            raise SceneError(f"{file}: walls[{k}]: give either fix (a LIGGGHTS wall fix id) or plane "
+                             f"({', '.join(PLANES)})")
+    return PostScene(path, materials, types, [m.temperature for m in materials.values()], walls)
+
+
+class Particles:
+    """Per-id arrays (index = LIGGGHTS id), grown as ids appear: type (0 unseen), radius [m],
+    initial temperature [K] (NaN until known)."""
+
+    def __init__(self):
+        self.type, self.radius, self.T0 = np.zeros(0, int), np.zeros(0), np.zeros(0)
+
+    def add(self, ids, types, radius, temperature=None) -> None:
+        n = int(ids.max()) + 1 if len(ids) else 0
+        if n > len(self.type):
+            grow = n - len(self.type)
+            self.type = np.concatenate([self.type, np.zeros(grow, int)])
+            self.radius = np.concatenate([self.radius, np.full(grow, np.nan)])
+            self.T0 = np.concatenate([self.T0, np.full(grow, np.nan)])
+        self.type[ids], self.radius[ids] = types, radius
+        if temperature is not None:
+            self.T0[ids] = np.where(np.isnan(self.T0[ids]), temperature, self.T0[ids])
+
+
+@dataclass
+class Found:
+    """Collisions found (first appearances), as lists of arrays until ``array()``."""
+
+    columns = ("step", "i", "j", "delta", "approach", "window")
+    parts: dict = field(default_factory=lambda: {c: [] for c in Found.columns})
+
+    def add(self, **arrays) -> None:
+        for c in self.columns:
+            self.parts[c].append(np.broadcast_to(arrays[c], np.shape(arrays["i"])).astype(float))
+
+    def array(self) -> dict:
+        out = {c: np.concatenate(v) if v else np.zeros(0) for c, v in self.parts.items()}
+        order = np.argsort(out["step"], kind="stable")
+        out = {c: a[order] for c, a in out.items()}
+        out["i"], out["j"] = out["i"].astype(np.int64), out["j"].astype(np.int64)
+        return out
+
+
+class FirstAppearances:
+    """Keys of the previous frame of one contact stream; ``new(keys)`` gives which are new."""
+
+    def __init__(self):
+        self.previous = np.empty(0, np.int64)
+
+    def new(self, keys):
+        fresh = ~np.isin(keys, self.previous)
+        self.previous = keys
+        return fresh
+
+
+ATOMS_REQUIRED = ("id", "type", "position", "velocity", "radius")
+
+
+class Post:
+    """One post-processing job; ``run()`` writes the output folder and returns the summary."""
+
+    def __init__(self, dumps, scene: PostScene, out, contacts=(), script=None, computes=None, models=MODELS,
+                 dt=None, skip_bad_frames=False):
+        self.dumps, self.scene, self.out = list(dumps), scene, Path(out)
+        self.contacts, self.script = list(contacts), script
+        self.computes = dict(script.computes if script else {}) | dict(computes or {})
+        self.models, self.skip = tuple(models), skip_bad_frames
+        self.dt = dt if dt is not None else (script.timestep if script else None)
+        if self.dt is None:
+            raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
+        self.warnings = list(script.warnings) if script else []
+        self.particles = Particles()
+        self.summary = dict(frames=0, particles=0, collisions=dict(particle_particle=0, particle_wall=0),
+                            heat_J={m: 0.0 for m in self.models}, warnings=self.warnings, complete=False)
+        self.stop_step = None            # the last good step before a failure: nothing after it is used
+        self.error, self.done = None, False
+
+    # -- reading ----------------------------------------------------------------------------
+    def reader(self, paths, **kw):
+        r = DumpReader(paths, dt=self.dt, skip_bad_frames=self.skip, **kw)
+        self.warnings.extend(r.warnings)
+        return r
+
+    def frames(self, reader):
+        """Frames up to a failure; the failure is recorded, not raised, so what came before is kept."""
+        seen, last = len(reader.warnings), -1
+        try:
+            for f in reader:
+                if self.stop_step is not None and f.step > self.stop_step:
+                    return
+                last = f.step
+                yield f
+        except DumpError as exc:
+            self.error = exc if self.error is None else self.error
+            self.stop_step = last if self.stop_step is None else min(last, self.stop_step)
+        finally:
+            self.warnings.extend(reader.warnings[seen:])
+
+    def survey(self) -> Found:
+        """Pass over the particle dumps: particle table, frames, intervals; contacts from
+        positions when there are no contact dumps."""
+        found, first = Found(), FirstAppearances()
+        walls = [(k, w.plane) for k, w in enumerate(self.scene.walls) if w.plane]
+        if not self.contacts:
+            for w in self.scene.walls:
+                if w.fix:
+                    self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps (wall/gran/local); "
+                                         "without them it is ignored")
+        steps, last = [], None
+        for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
+            ids, types = f["id"].astype(np.int64), f["type"].astype(int)
+            unknown = sorted(set(types.tolist()) - set(self.scene.types))
+            if unknown:
+                raise ValueError(f"{f.file}: timestep {f.step}: atom type {unknown[0]} is in no material of "
+                                 f"{self.scene.path} (materials.NAME.types)")
+            temp = f["f_Temp"] if "f_Temp" in f else None
+            self.particles.add(ids, types, f["radius"], temp)
+            steps.append(f.step)
+            last = f
+            if not self.contacts:
+                self.position_contacts(f, ids, walls, found, first, steps)
+        self.summary["frames"] = len(steps)
+        self.summary["particles"] = len(last) if last is not None else 0
+        self.dump_steps = np.diff(steps).min() if len(steps) > 1 else None
+        self.interval = self.dump_steps
+        return found
+
+    def position_contacts(self, f, ids, walls, found, first, steps) -> None:
+        if not len(f):
+            first.new(np.empty(0, np.int64))
+            return
+        if walls and f.box is None:
+            raise ValueError(f"{f.file}: a VTK dump has no box, so plane walls cannot be placed: use text dumps")
+        x = f.positions()
+        box = f.box if f.box is not None else np.stack([x.min(0) - 1.0, x.max(0) + 1.0], axis=1)
+        c = find_contacts(x, f.vector("v"), f["radius"], box.ravel(), f.periodic, [p for _, p in walls])
+        wall = c.j >= WALL_BASE
+        j = ids[np.where(wall, 0, c.j)]
+        j[wall] = WALL_BASE + MESHES * np.array([k for k, _ in walls], np.int64)[c.j[wall] - WALL_BASE]
+        keys = contact_keys(ids[c.i], j)
+        new = first.new(keys)
+        window = (steps[-1] - steps[-2]) * self.dt if len(steps) > 1 else 0.0
+        found.add(step=f.step, i=ids[c.i][new], j=j[new], delta=c.delta[new], approach=c.approach[new], window=window)
+
+    def contact_streams(self) -> dict:
+        """Contact dump files grouped by the compute their columns come from (one stream each)."""
+        streams = {}
+        for p in expand(self.contacts):
+            try:
+                with open_text(p) as f:
+                    head = [f.readline() for _ in range(9)]
+            except STREAM_ERRORS as exc:
+                raise DumpError(p, None, 1, f"unreadable ({type(exc).__name__}: {exc})") from None
+            cid = head[8].split()[2].split("[")[0][2:] if head[8].startswith("ITEM: ENTRIES c_") else None
+            if cid is None:
+                raise DumpError(p, None, 9, f"not a dump local of a compute: {head[8].strip()[:60]!r}")
+            streams.setdefault(cid, []).append(p)
+        return streams
+
+    def dump_contacts(self, found: Found) -> None:
+        """Collisions from contact dumps: a contact's first appearance in its stream."""
+        intervals = []
+        for cid, paths in self.contact_streams().items():
+            first, previous = FirstAppearances(), None
+            for f in self.frames(self.reader(paths, computes=self.computes)):
+                if f.kind not in ("pair", "wall"):
+                    raise DumpError(f.file, f.step, f.line, "not a dump of compute pair/gran/local or wall/gran/local")
+                missing = [g for g in ("x_i", "v_i", "id_i") + (("x_j", "v_j", "id_j") if f.kind == "pair"
+                                                                  else ("x_contact", "v_wall", "mesh"))
+                           if g not in f.groups]
+                if missing:
+                    raise DumpError(f.file, f.step, f.line, f"contact dump lacks {', '.join(missing)}: the compute "
+                                                            "needs the keywords pos, vel and id, all dumped")
+                window = (f.step - previous) * self.dt if previous is not None else 0.0
+                if previous is not None:
+                    intervals.append(f.step - previous)
+                previous = f.step
+                if len(f):
+                    self.add_dump_contacts(f, cid, first, found, window)
+                else:
+                    first.new(np.empty(0, np.int64))        # an empty frame ends every contact
+        if intervals:
+            self.interval = min(intervals)
+
+    def wall_index(self, cid: str) -> int:
+        fixes = [k for k, w in enumerate(self.scene.walls) if w.fix]
+        if self.script and self.script.mesh_wall_fixes:
+            fix = self.script.mesh_wall_fixes[-1]       # wall/gran/local reports the last mesh wall fix
+            match = [k for k in fixes if self.scene.walls[k].fix == fix]
+            if not match:
+                raise ValueError(f"{self.scene.path}: wall contacts of compute {cid} come from fix {fix}: "
+                                 f"no [[walls]] entry has fix = {fix!r}")
+            return match[0]
+        if len(fixes) != 1:
+            raise ValueError(f"{self.scene.path}: wall contacts of compute {cid}: which [[walls]] entry they belong "
+                             f"to needs exactly one wall with 'fix', or --script; {len(fixes)} have one")
+        return fixes[0]
+
+    def add_dump_contacts(self, f, cid, first, found, window) -> None:
+        ids_i = self.checked_ids(f, f["id_i"])
+        r_i = self.particles.radius[ids_i]
+        if f.kind == "pair":
+            ids_j = self.checked_ids(f, f["id_j"])
+            d = f.vector("x_i") - f.vector("x_j")
+            size = f.box[:, 1] - f.box[:, 0]
+            d -= np.where(f.periodic, size * np.round(d / size), 0.0)
+            v_rel = f.vector("v_i") - f.vector("v_j")
+            gap = self.particles.radius[ids_j] + r_i
+            j = ids_j
+        else:
+            d = f.vector("x_i") - f.vector("x_contact")
+            v_rel = f.vector("v_i") - f.vector("v_wall")
+            gap = r_i
+            j = WALL_BASE + MESHES * self.wall_index(cid) + f["mesh"].astype(np.int64)
+        dist = np.linalg.norm(d, axis=1)
+        n = d / np.where(dist > 0, dist, 1.0)[:, None]
+        delta = f["delta"] if "delta" in f else gap - dist
+        approach = -np.einsum("ij,ij->i", v_rel, n)
+        keys = contact_keys(ids_i, j)
+        order = np.lexsort((-delta, keys))               # per key, the row of largest overlap first
+        keys, first_row = np.unique(keys[order], return_index=True)
+        rows = order[first_row]
+        new = first.new(keys)
+        rows = rows[new]
+        found.add(step=f.step, i=ids_i[rows], j=j[rows], delta=delta[rows], approach=approach[rows], window=window)
+
+    def checked_ids(self, f, ids):
+        ids = ids.astype(np.int64)
+        known = (ids < len(self.particles.type)) & (ids > 0)
+        known[known] = self.particles.type[ids[known]] > 0
+        if not known.all():
+            raise DumpError(f.file, f.step, f.line, f"particle id {ids[~known][0]} is in no particle dump")
+        return ids
+
+    # -- physics from the plugin ---------------------------------------------------------------
+    def material_of(self, types):
+        """Material index of LIGGGHTS atom types (scene's materials.NAME.types)."""
+        lookup = np.zeros(max(self.scene.types) + 1, int)
+        lookup[list(self.scene.types)] = list(self.scene.types.values())
+        return lookup[types]
+
+    def bodies(self, i, j):
+        """Material index, radius [m] and mass [kg] of partners i (particles) and j (particle
+        or wall), and whether j is a wall and which."""
+        mats = list(self.scene.materials.values())
+        density = np.array([m.density for m in mats])
+        wall = j >= WALL_BASE
+        w = np.where(wall, (j - WALL_BASE) // MESHES, 0)
+        wall_mat = np.array([list(self.scene.materials).index(x.material) for x in self.scene.walls] or [0])
+        jj = np.where(wall, 0, j)
+        mi = self.material_of(self.particles.type[i])
+        mj = np.where(wall, wall_mat[w], self.material_of(self.particles.type[jj]))
+        R_i, R_j = self.particles.radius[i], np.where(wall, np.inf, self.particles.radius[jj])
+        m_i = 4.0 / 3.0 * np.pi * R_i**3 * density[mi]
+        m_j = np.where(wall, np.inf, 4.0 / 3.0 * np.pi * R_j**3 * density[mj])
+        return mi, mj, R_i, R_j, m_i, m_j, wall, w
+
+    def dem_laws(self, mi, mj):
+        mats = list(self.scene.materials.values())
+        laws = {}
+        for a, b in set(zip(mi.tolist(), mj.tolist())):
+            A, B = mats[a].dem, mats[b].dem
+            Y = 1.0 / ((1 - A.poisson_ratio**2) / A.youngs_modulus + (1 - B.poisson_ratio**2) / B.youngs_modulus)
+            laws[a, b] = (Y, DemHertz(Y, 0.5 * (A.restitution + B.restitution)))
+        return laws
+
+    def impact_speeds(self, c) -> np.ndarray:
+        mi, mj, R_i, R_j, m_i, m_j, wall, _ = self.bodies(c["i"], c["j"])
+        R = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
+        m = np.where(wall, m_i, m_i * m_j / np.where(wall, 1.0, m_i + m_j))
+        v0 = c["approach"].copy()
+        for (a, b), (_, law) in self.dem_laws(mi, mj).items():
+            s = (mi == a) & (mj == b) & (c["delta"] > 0)
+            for window in np.unique(c["window"][s]):
+                w = s & (c["window"] == window)
+                v0[w] = law.impact_speed(c["delta"][w], c["approach"][w], R[w], m[w], window=window or None)
+        self.shortest_collision(mi, mj, R, m, v0)
+        return v0
+
+    def shortest_collision(self, mi, mj, R, m, v0) -> None:
+        """The DEM's shortest Hertz collision time among the collisions found, at the fastest
+        impact seen (1 m/s if none), against the dump interval."""
+        if not len(v0) or self.interval is None:
+            return
+        v = float(v0.max()) if np.any(v0 > 0) else 1.0
+        t_c = min(hertz_collision_time(Y, R[(mi == a) & (mj == b)].min(), m[(mi == a) & (mj == b)].min(), v)
+                  for (a, b), (Y, _) in self.dem_laws(mi, mj).items())
+        interval = self.interval * self.dt
+        self.summary.update(dump_interval_s=interval, shortest_collision_s=t_c)
+        if interval > t_c:
+            self.warnings.append(
+                f"the dump interval {interval:.3g} s ({self.interval} steps) exceeds the shortest DEM collision "
+                f"time {t_c:.3g} s (Hertz, at {v:.3g} m/s): collisions shorter than the interval are missed "
+                "and impact speeds are carried back over up to the whole interval")
+
+    # -- the job ------------------------------------------------------------------------------------
+    def run(self) -> dict:
+        self.out.mkdir(parents=True, exist_ok=True)
+        try:
+            found = self.survey()
+            if self.contacts:
+                self.dump_contacts(found)
+            c = found.array()
+            c["v0"] = self.impact_speeds(c)
+            self.heat(c)
+        finally:
+            self.write_summary()
+        if self.error is not None:
+            raise self.error
+        return self.summary
+
+    def write_summary(self) -> None:
+        self.summary["complete"] = self.error is None and self.done
+        self.summary["warnings"] = list(dict.fromkeys(self.warnings))    # the particle dumps are read twice
+        if self.error is not None:
+            self.summary["error"] = str(self.error)
+        (self.out / "summary.json").write_text(json.dumps(self.summary, indent=1, default=float))
+
+    def heat(self, c) -> None:
+        """Models over all collisions, heat moved in time order while the particle frames are
+        replayed into the VTK series; collisions.csv.gz written batch by batch."""
+        n = len(c["i"])
+        mi, mj, R_i, R_j, m_i, m_j, wall, w = self.bodies(c["i"], c["j"])
+        mats = list(self.scene.materials.values())
+        go = c["v0"] > 0                     # contacts that formed without approach move no collision heat
+        if (~go).any():
+            self.warnings.append(f"{int((~go).sum())} contacts formed with no approach speed: no collision heat")
+        G, e, t_coll = {}, {}, {}
+        for model in self.models:
+            G[model], e[model], t_coll[model] = np.zeros(n), np.full(n, np.nan), np.full(n, np.nan)
+            if go.any():
+                g, ee, tt = evaluate(model, "fast", mats, mi[go], mj[go], R_i[go], R_j[go], c["v0"][go], np.ones(go.sum()))
+                G[model][go], e[model][go], t_coll[model][go] = g, ee, tt
+        C = np.full(len(self.particles.type), np.nan)
+        known = self.particles.type > 0
+        heat_capacity = np.array([m.heat_capacity for m in mats])
+        density = np.array([m.density for m in mats])
+        mat = self.material_of(self.particles.type[known])
+        C[known] = 4.0 / 3.0 * np.pi * self.particles.radius[known] ** 3 * density[mat] * heat_capacity[mat]
+        T0 = self.initial_temperatures(known, mat)
+        T = {m: T0.copy() for m in self.models}
+        received = {m: np.zeros(len(T0)) for m in self.models}
+        T_wall = np.array([x.temperature if x.temperature > 0 else np.nan for x in self.scene.walls] or [np.nan])
+        j_exchange = np.where(wall, WALL_BASE + w, c["j"])
+        counted = dict(particle_particle=int((~wall).sum()), particle_wall=int(wall.sum()))
+        self.summary["collisions"] = counted
+        self.summary["capped"] = {m: 0 for m in self.models}
+        Q = {m: np.zeros(n) for m in self.models}
+        columns = (("time", "i", "j", "type_i", "type_j", "wall", "v0")
+                   + tuple(f"{k}_{m}" for m in self.models for k in ("Q", "e", "t_coll")))
+        series = VtkSeries(self.out / "vtk", "particles")
+        type_i = self.particles.type[c["i"]]
+        type_j = np.where(wall, 0, self.particles.type[np.where(wall, 0, c["j"])])
+        by_pair = np.stack([type_i, type_j], axis=1)
+        by_pair[~wall] = np.sort(by_pair[~wall], axis=1)       # 1-2 and 2-1 are one pair of types
+        pairs, pair_of = np.unique(by_pair, axis=0, return_inverse=True)
+        pairs, pair_of = [tuple(p) for p in pairs.tolist()], pair_of.ravel()
+        pair_sum = np.zeros(len(pairs))              # |Q| of the first model per type pair [J]
+        times, pair_heat, last = [], [], None
+        done = 0
+        with gzip.open(self.out / "collisions.csv.gz", "wt", newline="") as gz:
+            out = csv.writer(gz)
+            out.writerow(columns)
+
+            def upto(step):
+                nonlocal done
+                end = int(np.searchsorted(c["step"], step, side="right"))
+                s = slice(done, end)
+                if end == done:
+                    return
+                for m in self.models:
+                    moved, capped, _ = exchange_heat(T[m], C, c["i"][s], j_exchange[s], G[m][s], T_wall)
+                    Q[m][s] = moved
+                    np.add.at(received[m], c["i"][s], -moved)
+                    pp = ~wall[s]
+                    np.add.at(received[m], c["j"][s][pp], moved[pp])
+                    self.summary["capped"][m] += capped
+                    self.summary["heat_J"][m] += float(np.abs(moved).sum())
+                np.add.at(pair_sum, pair_of[s], np.abs(Q[self.models[0]][s]))
+                cols = [c["step"][s] * self.dt, c["i"][s], np.where(wall[s], 0, c["j"][s]), type_i[s], type_j[s],
+                        np.where(wall[s], w[s] + 1, 0), c["v0"][s]]
+                for m in self.models:
+                    cols += [Q[m][s], e[m][s], t_coll[m][s]]
+                out.writerows(zip(*(np.asarray(a).tolist() for a in cols)))
+                gz.flush()
+                done = end
+
+            for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
+                upto(f.step)
+                ids = f["id"].astype(np.int64)
+                fields = dict(id=ids, type=f["type"].astype(int), radius=f["radius"], velocity=f.vector("v"))
+                for m in self.models:
+                    fields[f"T_{m}"], fields[f"dT_{m}"] = T[m][ids], T[m][ids] - T0[ids]
+                    fields[f"heat_{m}"] = received[m][ids]
+                series.write(f.time, f.positions(), **fields)
+                times.append(f.time)
+                pair_heat.append(pair_sum.copy())
+                last = (f.time, f.positions(), fields[f"dT_{self.models[0]}"], self.models[0])
+            upto(np.inf if self.stop_step is None else self.stop_step)
+        self.done = True
+        if last is not None:
+            from pyhost.pictures import plot_post
+            self.summary["picture"] = str(plot_post(self.out, last, [f"{a}-{b or 'wall'}" for a, b in pairs],
+                                                    times, pair_heat))
+
+    def initial_temperatures(self, known, mat) -> np.ndarray:
+        T0 = np.full(len(self.particles.type), np.nan)
+        given = np.array(self.scene.temperature)[mat]
+        T0[known] = np.where(given > 0, given, self.particles.T0[known])
+        missing = known & np.isnan(T0)
+        if missing.any():
+            name = list(self.scene.materials)[mat[np.flatnonzero(missing[known])[0]]]
+            raise ValueError(f"{self.scene.path}: materials.{name}.temperature: needed (the dumps hold no f_Temp)")
+        return T0

@@ -1,0 +1,215 @@
+"""``python -m pyhost post`` on the dumps of a real LIGGGHTS pour (marked engines), and on bad input."""
+import csv
+import gzip
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import pyvista
+
+from pyhost.post import load_post_scene
+from pyhost.scene import SceneError
+
+ROOT = Path(__file__).resolve().parents[2]
+GLASS = """[materials.glass]
+types = [1, 2]
+density = 2500.0
+youngs_modulus = 63e9
+poisson_ratio = 0.22
+yield_stress = 500e6
+heat_capacity = 800.0
+conductivity = 1.0
+dem = { youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }
+"""
+STEEL_WALL = """
+[materials.steel]
+density = 7800.0
+youngs_modulus = 210e9
+poisson_ratio = 0.3
+yield_stress = 300e6
+heat_capacity = 470.0
+conductivity = 45.0
+dem = { youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }
+
+[[walls]]
+fix = "walls"
+material = "steel"
+temperature = 350.0
+"""
+
+
+def post(*args, cwd=ROOT):
+    return subprocess.run([sys.executable, "-m", "pyhost", "post", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=300)
+
+
+def rows(out):
+    with gzip.open(out / "collisions.csv.gz", "rt") as f:
+        return list(csv.DictReader(f))
+
+
+def first_appearances(files, key):
+    """Contacts new in each frame of a dump local, counted with plain Python from the rows."""
+    files = sorted(files, key=lambda p: int(p.name.split(".")[-1]))
+    previous, count = set(), 0
+    for path in files:
+        lines = path.read_text().splitlines()
+        current = {key(line.split()) for line in lines[9:]}
+        count += len(current - previous)
+        previous = current
+    return count
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize("told", ["script", "options"])
+def test_collision_counts_match_an_independent_count_of_the_contact_dumps(pour_dumps, tmp_path, told):
+    """The computes' keywords and dt from the script, or from options (typed as in the script)."""
+    (tmp_path / "scene.toml").write_text(GLASS + STEEL_WALL)
+    post_dir = pour_dumps / "post"
+    how = (["--script", pour_dumps / "in.pour"] if told == "script" else
+           ["--dt", "1e-5", "--compute", "cp pair/gran/local delta id vel pos", "--compute",
+            "cw wall/gran/local vel id pos delta"])
+    run = post(post_dir / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts", post_dir / "pair.*",
+               post_dir / "wall.*", *how, "--out", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    # columns of 'delta id vel pos' in LIGGGHTS' order (ENGINES.md): pair ids 13, 14; wall mesh 13, id 15
+    pairs = first_appearances(post_dir.glob("pair.*"), lambda w: frozenset((w[12], w[13])))
+    walls = first_appearances(post_dir.glob("wall.*"), lambda w: (w[12], w[14]))
+    print(f"collisions: {summary['collisions']}, independent count: {pairs} pair, {walls} wall")
+    assert summary["complete"] is True and summary["frames"] == 13 and summary["particles"] == 60
+    assert summary["collisions"] == {"particle_particle": pairs, "particle_wall": walls}
+    assert pairs > 50 and walls > 20
+    table = rows(tmp_path / "out")
+    assert len(table) == pairs + walls
+    wall = np.array([r["wall"] != "0" for r in table])
+    for model in "ABC":
+        Q = np.array([float(r[f"Q_{model}"]) for r in table])
+        # every particle starts at LIGGGHTS' 300 K (f_Temp) and stays below the 350 K wall: heat goes in
+        assert np.all(Q[wall] < 0.0) and np.abs(Q[~wall]).sum() > 0
+        assert summary["heat_J"][model] == pytest.approx(np.abs(Q).sum(), rel=1e-12)
+    # heat balance over the last frame (the run's end): what the particles gained is what the wall gave;
+    # collisions between particles move heat among them and cancel
+    reader = pyvista.get_reader(str(tmp_path / "out" / "vtk" / "particles.pvd"))
+    reader.set_active_time_value(reader.time_values[-1])
+    last = reader.read()[0]
+    C = 4 / 3 * np.pi * last["radius"] ** 3 * 2500.0 * 800.0
+    Q = np.array([float(r["Q_A"]) for r in table])
+    assert np.sum(C * last["dT_A"]) == pytest.approx(-Q[wall].sum(), rel=1e-9)
+    # per particle too; dT = T - T0 near 300 K carries about 1e-13 K of rounding, C < 0.03 J/K
+    assert np.allclose(last["heat_A"], C * last["dT_A"], rtol=1e-9, atol=1e-14)
+    assert (tmp_path / "out" / "post.png").stat().st_size > 10_000
+
+
+@pytest.mark.engines
+def test_positions_alone_find_the_pairs_liggghts_listed_and_warn_about_a_long_interval(pour_dumps, tmp_path):
+    """From positions dumped every 20 steps (the contact dumps' interval), the particle pairs are
+    those of LIGGGHTS' own contact list; from dumps every 500 steps most are missed, and the
+    command says why with the numbers."""
+    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1, 2]\ntemperature = 300"))
+    post_dir = pour_dumps / "post"
+    pairs = first_appearances(post_dir.glob("pair.*"), lambda w: frozenset((w[12], w[13])))
+    fine = post(post_dir / "fine.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-5", "--out", tmp_path / "fine",
+                "--model", "B")
+    assert fine.returncode == 0, fine.stderr
+    found = json.loads((tmp_path / "fine" / "summary.json").read_text())["collisions"]["particle_particle"]
+    print(f"from positions every 20 steps: {found}; LIGGGHTS' contact list: {pairs}")
+    assert abs(found - pairs) <= 0.02 * pairs          # %g positions: overlaps within 1e-7 m may differ
+    coarse = post(post_dir / "dump.*", "--scene", tmp_path / "scene.toml", "--dt", "1e-5", "--out", tmp_path / "coarse")
+    assert coarse.returncode == 0, coarse.stderr
+    summary = json.loads((tmp_path / "coarse" / "summary.json").read_text())
+    assert summary["collisions"]["particle_particle"] < pairs / 2
+    [warning] = [w for w in summary["warnings"] if "dump interval" in w]
+    assert "0.005 s (500 steps) exceeds the shortest DEM collision time" in warning
+    assert summary["shortest_collision_s"] < summary["dump_interval_s"] == pytest.approx(5e-3)
+
+
+HEAD = "ITEM: TIMESTEP\n{step}\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff ff\n0 0.01\n0 0.01\n0 0.01\n" \
+       "ITEM: ATOMS id type x y z vx vy vz radius \n"
+
+
+def test_a_failure_keeps_what_came_before_and_says_incomplete(tmp_path):
+    """Two spheres meet between frames 0 and 1; frame 2 is cut. Exit 2 with file, timestep and
+    line; the collision before the cut is on disk and summary.json says incomplete."""
+    frames = [(0, 0.0040, 0.0060), (10, 0.00450005, 0.00549995)]           # then 0.1 um of overlap
+    text = "".join(HEAD.format(step=s) + f"1 1 {a} 0.005 0.005 0.1 0 0 0.0005 \n2 1 {b} 0.005 0.005 -0.1 0 0 0.0005 \n"
+                   for s, a, b in frames)
+    text += HEAD.format(step=20) + "1 1 0.0045 0.005 0.005 0.1 0 0 0.0005 \n"
+    (tmp_path / "run.dump").write_text(text)
+    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1]\ntemperature = 300"))
+    run = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--out", tmp_path / "out")
+    assert run.returncode == 2
+    assert run.stderr.strip().splitlines() == [f"error: {tmp_path / 'run.dump'}: line 33: timestep 20: "
+                                               "file ends after 1 rows of 2 (truncated)"]
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["complete"] is False and "truncated" in summary["error"]
+    [row] = rows(tmp_path / "out")
+    assert (row["i"], row["j"], float(row["time"])) == ("1", "2", pytest.approx(1e-5))
+    assert 0.2 < float(row["v0"]) < 0.2 * 1.01       # approach 0.2 m/s, slowed a little by that overlap
+    skip = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--out", tmp_path / "skip",
+                "--skip-bad-frames")
+    assert skip.returncode == 0, skip.stderr
+    summary = json.loads((tmp_path / "skip" / "summary.json").read_text())
+    assert summary["complete"] is True and summary["frames"] == 2 and len(rows(tmp_path / "skip")) == 1
+    assert any("skipped" in w and "timestep 20" in w and "line 33" in w for w in summary["warnings"])
+
+
+@pytest.mark.parametrize("change, problem", [
+    (lambda s: s.replace("types = [1, 2]", "types = [1, 0]"), "types: atom types are integers >= 1"),
+    (lambda s: s + STEEL_WALL.replace('fix = "walls"', 'fix = "walls"\nplane = "zlo"'), "give either fix"),
+    (lambda s: s + STEEL_WALL.replace("types", "x").replace('material = "steel"', 'material = "wood"'),
+     "unknown material 'wood'"),
+    (lambda s: s.replace("types = [1, 2]", "types = [1, 2]\ntemperature = -3"), "temperature: must be"),
+    (lambda s: s.replace("density", "densty"), "densty: unknown key"),
+])
+def test_scene_errors_name_the_key(tmp_path, change, problem):
+    (tmp_path / "s.toml").write_text(change(GLASS))
+    with pytest.raises(SceneError, match=problem):
+        load_post_scene(tmp_path / "s.toml")
+
+
+def test_an_atom_type_without_material_is_an_error(tmp_path):
+    (tmp_path / "d").write_text(HEAD.format(step=0) + "1 3 0.004 0.005 0.005 0 0 0 0.0005 \n"
+                                "2 1 0.006 0.005 0.005 0 0 0 0.0005 \n")
+    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1]\ntemperature = 300"))
+    run = post(tmp_path / "d", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--out", tmp_path / "out")
+    assert run.returncode == 2 and "atom type 3 is in no material" in run.stderr
+
+
+@pytest.mark.engines
+def test_offline_agrees_with_the_online_run(pour_dumps, tmp_path):
+    """The pour run by the host (``pyhost run``, contacts sampled every 20 steps) and the same
+    script's own dumps (contacts every 20 steps) post-processed: the same collisions at the
+    same times, the same impact speeds to the 6 digits the dumps keep, the same heat."""
+    for name in ("in.pour", "floor.stl"):
+        (tmp_path / name).write_text((pour_dumps / name).read_text())
+    (tmp_path / "post").mkdir()
+    (tmp_path / "case.toml").write_text('[dem]\nscript = "in.pour"\n\n[effects]\ncontact_heat = "A"\n\n'
+                                        + GLASS + STEEL_WALL + "\n[time]\nsample_every = 20\n\n"
+                                        "[output]\npictures = false\n")
+    online = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "online")],
+                            capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert online.returncode == 0, online.stdout[-2000:] + online.stderr[-2000:]
+    offline = post(tmp_path / "post" / "dump.*", "--scene", tmp_path / "case.toml", "--contacts",
+                   tmp_path / "post" / "pair.*", tmp_path / "post" / "wall.*", "--script", tmp_path / "in.pour",
+                   "--model", "A", "--out", tmp_path / "offline")
+    assert offline.returncode == 0, offline.stderr
+    run = json.loads((tmp_path / "online" / "summary.json").read_text())
+    done = json.loads((tmp_path / "offline" / "summary.json").read_text())
+    assert done["collisions"] == {"particle_particle": run["particle_particle"], "particle_wall": run["particle_wall"]}
+    with open(tmp_path / "online" / "collisions.csv") as f:
+        on = {(round(float(r["time"]), 9), frozenset((r["i"], r["j"], r["wall"]))): r for r in csv.DictReader(f)}
+    off = {(round(float(r["time"]), 9), frozenset((r["i"], r["j"], r["wall"]))): r for r in rows(tmp_path / "offline")}
+    assert set(on) == set(off) and len(on) > 200
+    v_on, v_off = (np.array([float(d[k]["v0"]) for k in sorted(on, key=str)]) for d in (on, off))
+    Q_on = np.array([float(on[k]["Q"]) for k in sorted(on, key=str)])
+    Q_off = np.array([float(off[k]["Q_A"]) for k in sorted(on, key=str)])
+    wall = np.array([on[k]["wall"] != "0" for k in sorted(on, key=str)])
+    print(f"v0: max relative difference {np.max(np.abs(v_off / v_on - 1)):.2g}; wall heat "
+          f"{-Q_off[wall].sum():.6g} J offline, {-Q_on[wall].sum():.6g} J online")
+    assert np.allclose(v_off, v_on, rtol=5e-4)             # dumps keep 6 digits of x, v and the overlap
+    assert -Q_off[wall].sum() == pytest.approx(run["heat_from_walls"], rel=1e-4)
+    assert np.abs(Q_off[~wall]).sum() == pytest.approx(np.abs(Q_on[~wall]).sum(), rel=1e-3)
