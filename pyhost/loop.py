@@ -10,7 +10,9 @@ run command by command by ``run_scene``; each ``run N`` becomes ``Coupling.advan
                                           collision: impact speed, plugin heat, exchange in Temp;
                                           an ended one gets the model's restitution if asked;
                                           a script's fix heat/gran is undone during t_coll)
-    every coupling:    couple_fluid      (fluid force on particles, particles' fraction to fluid)
+    every coupling:    couple_fluid      (fluid force on particles, particles' fraction to fluid;
+                                          with convection, gas-particle heat over the interval:
+                                          particles' Temp now, the opposite heat into the gas)
     every frame:       write_frame       (history.csv, VTK)
 
 Temperatures live in LIGGGHTS' per-atom ``Temp``: the host reads and writes them there and
@@ -28,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from plugins import convection
 from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
                                temperature_difference)
 from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
@@ -41,6 +44,8 @@ from pyhost.script import ScriptError, parse_run
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
+GAS_COLUMNS = ("T_gas_mean", "gas_energy", "heat_convected", "heat_convected_gross", "heat_through_fluid_boundaries",
+               "heat_moved")
 
 
 @dataclass(frozen=True)
@@ -97,11 +102,13 @@ class Coupling:
         self.steps = 0
         self.totals = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0,
                            heat_from_walls=0.0, capped=0, clipped=0, heat_gran_undone=0.0,
-                           inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0)
+                           inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0,
+                           heat_convected=0.0, heat_convected_gross=0.0)
         self.CT_by_id = np.zeros(0)      # m c T of each id at its last sample [J] (energy balance)
         self.seen = np.zeros(0, bool)
         self.warned = set()
-        self.heat = self.effects["collision_heat"]
+        self.heat = self.effects["particle_temperatures"]
+        self.convection = self.effects["convection"] and fluid is not None
         self.laws = {}
         if self.heat and dem.info.heat_gran:
             self.check_capacities()
@@ -114,7 +121,8 @@ class Coupling:
         self.history = CsvLog(self.out / "history.csv", ("time", "particles", "T_mean", "T_min", "T_max")
                               + tuple(f"T_group{k}" for k in range(len(self.group_names)))
                               + ("sum_mcT", "heat_from_walls", "energy_in", "energy_out", "collisions",
-                                 "capped", "clipped") + (FLUID_COLUMNS if fluid is not None else ()))
+                                 "capped", "clipped") + (FLUID_COLUMNS if fluid is not None else ())
+                              + (GAS_COLUMNS if self.convection else ()))
         self.frames = VtkSeries(self.out / "vtk", "particles") if scene.output.vtk else None
         self.fluid_frames = VtkSeries(self.out / "vtk", "fluid") if fluid is not None and scene.output.vtk else None
         self.progress = Progress(end or math.inf, progress_every)
@@ -134,8 +142,12 @@ class Coupling:
         interrupt from here on finds a coupling to write its summary)."""
         if self.contacts_open and self.every["sample"]:
             self.open_present()
+        T_gas = self.fluid.temperature() if self.convection else None
         if self.fluid is not None:
             self.couple_fluid()
+        # the solver starts from the first fluid fraction it gets (no flow displaces the gas of
+        # the particles as placed): the gas's initial heat content with that fraction
+        self.gas_energy0 = float(np.sum(self.fluid.heat_capacity() * T_gas)) if self.convection else 0.0
         self.write_frame()
 
     def advance(self, n: int) -> None:
@@ -388,10 +400,37 @@ class Coupling:
     def couple_fluid(self) -> None:
         """The fluid's force on each particle from the current fluid, then the fluid advanced
         over the next coupling interval with these particles' fraction and drag."""
-        atoms = self.dem.atoms(temperature=False)
+        atoms = self.dem.atoms(temperature=self.convection)
         lo, hi, periodic = self.dem.box()
         x = np.where(periodic, lo + np.mod(atoms.x - lo, hi - lo), atoms.x)   # the DEM wraps only at re-neighbouring
-        self.dem.set_force(self.fluid.couple(x, atoms.v, 2.0 * atoms.radius, self.every["couple"] * self.dem.dt))
+        interval = self.every["couple"] * self.dem.dt
+        forces = self.fluid.particle_forces(x, atoms.v, 2.0 * atoms.radius)
+        self.fluid.advance(interval, heat=self.convect(atoms, interval) if self.convection else None)
+        self.dem.set_force(forces)
+
+    def convect(self, atoms, interval: float) -> np.ndarray:
+        """Gas-particle heat over the coming interval [s] (plugins.convection): each particle's
+        Temp takes its share now; returns the heat rate of each cell's gas [W], the opposite,
+        for the fluid's advance over the interval."""
+        f, name = self.fluid, self.scene.effects.convection
+        self.track_particles(atoms)
+        d = 2.0 * atoms.radius
+        alpha = f.alpha[f.cell]
+        re = convection.particle_reynolds(alpha, f.slip, d, f.nu)
+        pr = convection.prandtl(f.nu, f.rho, f.cp, f.kappa)
+        for key, share in convection.outside(name, re, pr, alpha).items():
+            if key not in self.warned:
+                self.warned.add(key)
+                lo, hi = convection.get(name).validity[key]
+                print(f"warning: convection '{name}' extrapolated: {share:.1%} of the particles have {key} outside "
+                      f"[{lo:g}, {hi:g}] at t = {self.t:g} s")
+        G = convection.conductance(name, re, pr, alpha, f.kappa, d)
+        q, _ = convection.exchange(atoms.T, self.C, G, f.cell, f.temperature(), f.heat_capacity(), interval)
+        atoms.T[:] += q / self.C
+        self.totals["heat_convected"] += float(q.sum())
+        self.totals["heat_convected_gross"] += float(np.abs(q).sum())
+        self.track_particles(atoms)
+        return -np.bincount(f.cell, q, len(f.cell_volumes)) / interval
 
     def bed_state(self, atoms) -> tuple:
         """The fluid columns of history.csv: the superficial inlet velocity [m/s]; the pressure
@@ -404,6 +443,18 @@ class Coupling:
         inlet = math.nan if self.scene.fluid.case else float(self.scene.fluid.inlet_at(self.t))
         return (inlet, layer_pressure_drop(self.fluid) + head,
                 2.0 * float(np.mean(atoms.x[:, 2] - floor)) if len(atoms.x) else math.nan)
+
+    def gas_state(self) -> tuple:
+        """The gas columns of history.csv: the heat-capacity weighted mean gas temperature [K],
+        the gas's heat content rho c alpha V T summed over cells [J]; since the start [J]: the
+        heat convected into the particles (net, and the sum of its magnitudes), the heat into
+        the gas through the fluid's boundaries, and beside them the heat moved by collisions
+        between particles (sum of magnitudes)."""
+        C = self.fluid.heat_capacity()
+        E = float(np.sum(C * self.fluid.temperature()))
+        t = self.totals
+        return (E / C.sum(), E, t["heat_convected"], t["heat_convected_gross"], self.fluid.boundary_heat,
+                t["heat_moved"])
 
     # -- output -------------------------------------------------------------------------
     def write_frame(self) -> None:
@@ -420,7 +471,8 @@ class Coupling:
         self.history.write([(self.t, len(atoms.id)) + stats + means
                             + (float(np.sum(C * T)), tot["heat_from_walls"], tot["energy_in"], tot["energy_out"],
                                tot["collisions"], tot["capped"], tot["clipped"])
-                            + (self.bed_state(atoms) if self.fluid is not None else ())])
+                            + (self.bed_state(atoms) if self.fluid is not None else ())
+                            + (self.gas_state() if self.convection else ())])
         if self.frames is not None:
             self.frames.write(self.t, atoms.x, id=atoms.id, type=atoms.type, radius=atoms.radius,
                               velocity=atoms.v, temperature=T)
@@ -437,9 +489,17 @@ class Coupling:
             self.track_particles(atoms)
             CT = float(np.sum(self.C * atoms.T))
             t = self.totals
-            summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=(    # relative to all
-                CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]      # that came in
-                - t["energy_set_by_script"]) / max(self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"]), 1e-300))
+            came_in = self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"])
+            residual = (CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]
+                        - t["energy_set_by_script"] - t["heat_convected"])                    # J
+            summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT,
+                           energy_balance_error=residual / max(came_in, 1e-300))             # relative to all that came in
+            if self.convection and status == "completed":   # particles and gas; the gas gains through its boundaries
+                _, gas, _, _, through, _ = self.gas_state()
+                residual += t["heat_convected"] + gas - self.gas_energy0 - through
+                summary.update(gas_energy_start=self.gas_energy0, gas_energy_end=gas,
+                               heat_through_fluid_boundaries=through,
+                               total_energy_balance_error=residual / max(came_in + self.gas_energy0 + abs(through), 1e-300))
         write_atomic(self.out / "summary.json", json.dumps(summary, indent=1))
         self.collisions.close()
         self.history.close()
@@ -462,7 +522,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             run = parse_run(cmd)
             if coupling is None:
                 try:
-                    added = dem.prepare(heat=effects["collision_heat"], contacts=effects["contact_extraction"],
+                    added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
                                         fluid_force=fluid is not None)
                 except LiggghtsError as exc:
                     raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None

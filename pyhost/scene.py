@@ -50,6 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
+from plugins.convection import CORRELATIONS
 from plugins.heat import MODEL_NAMES, MODELS
 
 
@@ -96,6 +97,9 @@ class Effects:
     enduring_conduction: bool = spec(default=False, doc="box scenes: LIGGGHTS' fix heat/gran conducts through "
                                                          "particle contacts that outlast a collision")
     wall_heat: bool = spec(default=True, doc="collisions with walls at a fixed temperature exchange heat")
+    convection: str = spec("in:none," + ",".join(sorted(CORRELATIONS)), "none",
+                           "gas-particle convection: Nusselt correlation (plugins.convection); turns on the "
+                           "gas energy equation of the fluid")
 
     @property
     def heat_models(self) -> tuple:
@@ -146,7 +150,8 @@ class Wall:
     material: str = spec(doc="key of [materials]")
     plane: str = spec("in:,xlo,xhi,ylo,yhi,zlo,zhi", "", "which face of the box (box scenes)")
     fix: str = spec(default="", doc="id of the script's fix wall/gran, primitive or mesh (script scenes)")
-    temperature: float = spec(">=0", 0.0, "fixed temperature [K]; 0 means adiabatic")
+    temperature: float = spec(">=0", 0.0, "fixed temperature [K] (for collisions; with effects.convection also "
+                                           "the gas at that side of a box scene); 0 means adiabatic")
 
 
 @dataclass(frozen=True)
@@ -173,6 +178,15 @@ class Fluid:
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
     sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")
     alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]")
+    conductivity: float = spec(">0", 0.026, "gas thermal conductivity [W/(m K)] (with effects.convection)")
+    heat_capacity: float = spec(">0", 1005.0, "gas specific heat capacity [J/(kg K)] (with effects.convection)")
+    temperature: float = spec(">0", 293.15, "initial gas temperature [K] (with effects.convection)")
+    inlet_temperature: float = spec(">=0", 0.0, "gas temperature at the inlet [K]; 0: the initial temperature")
+
+    @property
+    def prandtl(self) -> float:
+        """Gas Prandtl number mu c / k (-)."""
+        return self.viscosity * self.heat_capacity / self.conductivity
 
     def inlet_at(self, t):
         """Superficial inlet velocity [m/s] at time t [s] (scalar or array)."""
@@ -232,8 +246,11 @@ class Scene:
     def effects_summary(self) -> dict:
         """What the host builds for this scene."""
         heat = bool(self.effects.heat_models)
+        convection = self.effects.convection != "none"
         return dict(
             fluid_solver=self.effects.fluid,
+            convection=convection,
+            particle_temperatures=heat or convection,
             contact_extraction=heat or self.effects.restitution_feedback,
             collision_heat=heat,
             restitution_feedback=self.effects.restitution_feedback,
@@ -364,8 +381,10 @@ def load_scene(path) -> Scene:
                          f"first in effects.contact_heat; comparison models give no restitution")
     if effects.fluid and fluid is None:
         raise SceneError(f"{file}: fluid: missing section, but effects.fluid = true")
+    if effects.convection != "none" and not effects.fluid:
+        raise SceneError(f"{file}: effects.convection: needs the gas (effects.fluid = true)")
     if fluid is not None and fluid.case:
-        _user_fluid_case(fluid, path, file)
+        _user_fluid_case(fluid, path, file, effects.convection != "none")
     elif effects.fluid and scripted:
         raise SceneError(f"{file}: fluid.case: a script scene needs its OpenFOAM case (the host generates "
                          "a fluid only for the box world)")
@@ -393,19 +412,20 @@ FLUID_CASE_FILES = ("system/controlDict", "system/fvSchemes", "system/fvSolution
                     "constant/transportProperties")
 
 
-def _user_fluid_case(fluid, path, file):
-    """A user's OpenFOAM case: the files collheatFoam reads, a mesh or a blockMeshDict, and no
-    scene key that the case itself decides."""
+def _user_fluid_case(fluid, path, file, energy: bool):
+    """A user's OpenFOAM case: the files collheatFoam reads (0/T for the gas energy), a mesh or
+    a blockMeshDict, and no scene key that the case itself decides."""
     folder = path.resolve().parent / fluid.case
     if not folder.is_dir():
         raise SceneError(f"{file}: fluid.case: no such folder {str(folder)!r}")
-    missing = [f for f in FLUID_CASE_FILES if not (folder / f).is_file()]
+    missing = [f for f in FLUID_CASE_FILES + (("0/T",) if energy else ()) if not (folder / f).is_file()]
     if not (folder / "constant" / "polyMesh" / "owner").is_file() and not (folder / "system" / "blockMeshDict").is_file():
         missing.append("constant/polyMesh or system/blockMeshDict")
     if missing:
         raise SceneError(f"{file}: fluid.case: {folder} lacks what collheatFoam needs: {', '.join(missing)}")
     default = Fluid()
-    for key in ("density", "viscosity", "inlet_velocity", "inlet_table", "plenum", "cells", "sides"):
+    for key in ("density", "viscosity", "inlet_velocity", "inlet_table", "plenum", "cells", "sides",
+                "temperature", "inlet_temperature"):
         if getattr(fluid, key) != getattr(default, key):
             raise SceneError(f"{file}: fluid.{key}: comes from the OpenFOAM case {fluid.case!r}, not from the scene")
 

@@ -32,26 +32,37 @@ def start_fluid(scene, folder: Path):
     """The scene's fluid: a box case (pyhost.engines.fluid_case) over the domain and the plenum below
     it, inlet at its z lo, outlet at z hi, solved by collheatFoam every time.couple_every DEM
     steps. The inlet value is the fluid velocity there, so the superficial velocity asked for
-    needs a particle-free inlet (a plenum) to be met."""
+    needs a particle-free inlet (a plenum) to be met. With convection the gas has a
+    temperature: the scene's initial and inlet temperatures, walls of the scene's [[walls]]
+    on the box's sides at their fixed temperature, the other walls adiabatic."""
+    from foamlib import FoamFile
+
     from pyhost.engines.fluid_case import box_case
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
+    energy = scene.effects.convection != "none"
     if f.case:                          # the user's own case, copied: the host never writes into it
         shutil.rmtree(folder, ignore_errors=True)
         shutil.copytree(scene.folder / f.case, folder, symlinks=True,
                         ignore=shutil.ignore_patterns("processor*", ".link", "log.*", "[1-9]*", "0.[0-9]*"))
-        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min).start()
+        if energy:                      # the gas's properties are the scene's, given once
+            FoamFile(folder / "constant" / "transportProperties").update({"Cp": f.heat_capacity,
+                                                                           "kappa": f.conductivity})
+        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
              else ("inlet", (0.0, 0.0, f.inlet_velocity)))
     boundaries.update(zlo=inlet, zhi="outlet")
     lo = [box[0], box[2], box[4] - f.plenum]
+    sides = {w.plane: w.temperature for w in scene.walls if w.plane in boundaries and w.temperature > 0}
     case = box_case(folder, lo=lo, hi=box[1::2], cells=f.cells, boundaries=boundaries, rho=f.density,
                     nu=f.viscosity / f.density, gravity=scene.domain.gravity,
-                    dt=scene.time.couple_every * scene.time.dem_step)
-    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min).start()
+                    dt=scene.time.couple_every * scene.time.dem_step,
+                    T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
+                    T_inlet=f.inlet_temperature or f.temperature, T_walls=sides)
+    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy).start()
 
 
 def box_world(scene, out: Path, fluid_force: bool, start=None):

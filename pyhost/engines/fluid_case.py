@@ -8,6 +8,10 @@ the six faces (xlo, xhi, ylo, yhi, zlo, zhi) gets one boundary kind:
 - ``("inlet_table", [(t, (ux, uy, uz)), ...])``: velocity (m/s) piecewise linear in time t
   (s), held after the last row (OpenFOAM's uniformFixedValue table), fixedFluxPressure;
 - ``"outlet"``: fixed pressure 0, velocity zeroGradient (inletOutlet).
+
+With a gas temperature (``T0``) the case also gets 0/T for ``collheatFoam -energy``: inlets
+at ``T_inlet``, outlets zeroGradient (T0 for backflow), walls adiabatic unless
+``T_walls`` gives a face its fixed temperature (K); Cp and kappa go to transportProperties.
 """
 from __future__ import annotations
 
@@ -40,6 +44,8 @@ def _bc(kind, field: str) -> dict:
     name, value = (kind if isinstance(kind, tuple) else (kind, None))
     if name not in ("wall", "slip", "inlet", "inlet_table", "outlet"):
         raise ValueError(f"unknown boundary kind '{name}'; choices: wall, slip, inlet, inlet_table, outlet")
+    if field == "T":
+        return _temperature_bc(name, value)
     if field == "U" and name == "inlet_table":
         rows = [[float(t), [float(c) for c in u]] for t, u in value]
         return {"type": "uniformFixedValue", "uniformValue": ("table", rows), "value": np.array(rows[0][1])}
@@ -53,16 +59,30 @@ def _bc(kind, field: str) -> dict:
     return {"type": "fixedFluxPressure", "value": 0.0}
 
 
+def _temperature_bc(name, value) -> dict:
+    """0/T of a face: ``value`` is (T0, T_inlet, T_wall or None) in K."""
+    T0, T_inlet, T_wall = value
+    if name in ("inlet", "inlet_table"):
+        return {"type": "fixedValue", "value": float(T_inlet)}
+    if name == "outlet":
+        return {"type": "inletOutlet", "inletValue": float(T0), "value": float(T0)}
+    return {"type": "zeroGradient"} if T_wall is None else {"type": "fixedValue", "value": float(T_wall)}
+
+
 def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, nu: float,
              gravity=(0.0, 0.0, -9.81), dt: float = 1e-3, nprocs: int = 1,
              n_correctors: int = 2, n_outer: int = 1, max_speed: float = 1e3,
-             rel_tol: float = 0.01) -> Path:
+             rel_tol: float = 0.01, T0: float | None = None, cp: float = 1005.0, kappa: float = 0.026,
+             T_inlet: float | None = None, T_walls: dict | None = None) -> Path:
     """Write the case at ``path`` and return it. ``lo``, ``hi``: box corners (m);
     ``cells``: cells per axis; ``boundaries``: kind per face (module doc); ``rho`` (kg/m^3),
     ``nu`` (m^2/s): fluid; ``dt``: default time step (s); ``nprocs``: ranks of the
     decomposeParDict (method simple, split along x); ``n_correctors``, ``n_outer``: PISO and
     PIMPLE loops; ``max_speed``: speed (m/s) taken as divergence; ``rel_tol``: relative
-    tolerance of the pressure solver before the final corrector (absolute 1e-10)."""
+    tolerance of the pressure solver before the final corrector (absolute 1e-10); ``T0``
+    (K): initial gas temperature, None for no gas energy; ``cp`` (J/(kg K)), ``kappa``
+    (W/(m K)): the gas's heat capacity and conductivity; ``T_inlet`` (K, default T0): inlet
+    temperature; ``T_walls``: {face: fixed temperature K} (other walls adiabatic)."""
     path = Path(path)
     missing = set(FACES) - set(boundaries)
     if missing:
@@ -94,7 +114,8 @@ def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, n
         "gradSchemes": {"default": ("Gauss", "linear")},
         "divSchemes": {"default": "none", "div(alphaPhi,U)": ("Gauss", "limitedLinearV", 1),
                        "div(((alpha*nuEff)*dev2(T(grad(U)))))": ("Gauss", "linear"),
-                       "div(phi,U)": ("Gauss", "limitedLinearV", 1)},
+                       "div(phi,U)": ("Gauss", "limitedLinearV", 1),
+                       "div(alphaPhi,T)": ("Gauss", "limitedLinear", 1)},
         "laplacianSchemes": {"default": ("Gauss", "linear", "corrected")},
         "interpolationSchemes": {"default": "linear"},
         "snGradSchemes": {"default": "corrected"},
@@ -106,6 +127,9 @@ def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, n
             "pFinal": {"solver": "GAMG", "smoother": "DIC", "tolerance": 1e-10, "relTol": 0},
             '"(U|UFinal)"': {"solver": "smoothSolver", "smoother": "symGaussSeidel",
                            "tolerance": 1e-10, "relTol": 0},
+            # tight: the gas energy is conserved to the residual of this solver
+            '"(T|TFinal)"': {"solver": "PBiCGStab", "preconditioner": "DILU", "tolerance": 1e-14,
+                             "relTol": 0, "maxIter": 1000},
         },
         "PIMPLE": {"momentumPredictor": True, "nOuterCorrectors": n_outer,
                    "nCorrectors": n_correctors, "nNonOrthogonalCorrectors": 0,
@@ -116,7 +140,7 @@ def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, n
                       "coeffs": {"n": [nprocs, 1, 1]}})
 
     transport = _dict(path / "constant" / "transportProperties")
-    transport.update({"transportModel": "Newtonian", "nu": nu, "rho": rho})
+    transport.update({"transportModel": "Newtonian", "nu": nu, "rho": rho, "Cp": cp, "kappa": kappa})
     turbulence = _dict(path / "constant" / "turbulenceProperties")
     turbulence["simulationType"] = "laminar"
     g = _dict(path / "constant" / "g", "uniformDimensionedVectorField")
@@ -129,4 +153,13 @@ def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, n
         f["dimensions"] = FoamFile.DimensionSet(**dims)
         f["internalField"] = zero
         f["boundaryField"] = {face: _bc(kind, field) for face, kind in boundaries.items()}
+    (path / "0" / "T").unlink(missing_ok=True)
+    if T0 is not None:
+        T_walls = T_walls or {}
+        f = _dict(path / "0" / "T", "volScalarField")
+        f["dimensions"] = FoamFile.DimensionSet(temperature=1)
+        f["internalField"] = float(T0)
+        f["boundaryField"] = {face: _bc((kind[0] if isinstance(kind, tuple) else kind,
+                                         (T0, T0 if T_inlet is None else T_inlet, T_walls.get(face))), "T")
+                              for face, kind in boundaries.items()}
     return path

@@ -33,7 +33,7 @@ from plugins import drag as drag_laws
 
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
 SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[2] / ".setup" / "bin" / "collheatFoam"))
-LOCATE, ADVANCE, FIELDS, WRITE, STOP = 1, 2, 3, 4, 5
+LOCATE, ADVANCE, FIELDS, WRITE, STOP, TEMPERATURE = 1, 2, 3, 4, 5, 6
 TIMEOUT = float(os.environ.get("COLLHEAT_FLUID_TIMEOUT", 120.0))   # s, see the module doc
 
 
@@ -91,12 +91,15 @@ class FluidSolver:
     system/decomposeParDict). ``drag``: name of a law in :mod:`plugins.drag`.
     ``alpha_min``: floor of the fluid volume fraction handed to the solver (-).
     ``timeout``: seconds the host waits for one answer of the solver.
+    ``energy``: also solve the gas temperature (``collheatFoam -energy``: the case needs 0/T
+    and ``Cp``, ``kappa`` in transportProperties); :meth:`advance` then takes the heat of
+    each cell (W), :meth:`temperature` gives the cells' T.
 
     Use ``with FluidSolver(case) as fluid: ...`` or :meth:`start` / :meth:`stop`.
     """
 
     def __init__(self, case: str | os.PathLike, *, nprocs: int = 1, drag: str = "gidaspow",
-                 alpha_min: float = 0.3, timeout: float = TIMEOUT):
+                 alpha_min: float = 0.3, timeout: float = TIMEOUT, energy: bool = False):
         self.case = Path(case).resolve()
         if not (self.case / "system" / "controlDict").is_file():
             raise FluidError(f"{self.case} is not an OpenFOAM case (no system/controlDict)")
@@ -108,6 +111,14 @@ class FluidSolver:
         props = FoamFile(self.case / "constant" / "transportProperties")
         self.nu = _value(props["nu"])
         self.rho = _value(props["rho"])
+        self.energy = energy
+        if energy:
+            missing = [k for k in ("Cp", "kappa") if k not in props]
+            if missing or not (self.case / "0" / "T").is_file():
+                raise FluidError(f"{self.case}: the gas energy needs 0/T and Cp, kappa in "
+                                 f"constant/transportProperties; missing: {', '.join(missing) or '0/T'}")
+            self.cp, self.kappa = _value(props["Cp"]), _value(props["kappa"])
+        self.boundary_heat = 0.0     # J into the gas through the case's boundaries so far
         self.log = self.case / "log.collheatFoam"
         self.proc: subprocess.Popen | None = None
         self._fds: list[tuple[int, int]] = []
@@ -121,7 +132,7 @@ class FluidSolver:
             raise FluidError(f"{SOLVER} is missing: run tools/setup.sh --engines")
         if not (self.case / "constant" / "polyMesh" / "owner").is_file():
             run_utility(self.case, "blockMesh")
-        command = [str(SOLVER), "-case", str(self.case)]
+        command = [str(SOLVER), "-case", str(self.case)] + (["-energy"] if self.energy else [])
         if self.nprocs > 1:
             for old in self.case.glob("processor*"):
                 shutil.rmtree(old)
@@ -153,6 +164,7 @@ class FluidSolver:
         self.cell_volumes = np.concatenate(volumes)
         n = len(self.cell_volumes)
         self._alpha, self._ksl, self._us = np.ones(n), np.zeros(n), np.zeros((n, 3))
+        self.cell, self.slip = np.zeros(0, np.int64), np.zeros(0)
         self._busy = False
         return self
 
@@ -214,7 +226,9 @@ class FluidSolver:
         """Fluid force on each particle (N, shape (n, 3)) from the current fluid: drag
         ``K (u - v)`` plus pressure gradient ``-V_p grad p``; also sets the per-cell fluid
         fraction, exchange coefficient Ksl and particle velocity Us used by the next
-        :meth:`advance`. ``x`` positions (m), ``v`` velocities (m/s), ``d`` diameters (m)."""
+        :meth:`advance`, and keeps each particle's cell (``self.cell``) and slip speed
+        |u - v| (``self.slip``, m/s). ``x`` positions (m), ``v`` velocities (m/s), ``d``
+        diameters (m)."""
         x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 3)
         v = np.asarray(v, dtype=np.float64).reshape(-1, 3)
         d = np.broadcast_to(np.asarray(d, dtype=np.float64), (len(x),))
@@ -224,7 +238,8 @@ class FluidSolver:
         solid = np.bincount(cell, weights=vp, minlength=ncells) / self.cell_volumes
         alpha = np.maximum(1.0 - solid, self.alpha_min)
         slip = u - v
-        k = self.drag_law(alpha[cell], np.linalg.norm(slip, axis=1), d, self.rho, self.nu)
+        self.cell, self.slip = cell, np.linalg.norm(slip, axis=1)
+        k = self.drag_law(alpha[cell], self.slip, d, self.rho, self.nu)
         ksum = np.bincount(cell, weights=k, minlength=ncells)
         kv = np.stack([np.bincount(cell, weights=k * v[:, i], minlength=ncells)
                        for i in range(3)], axis=1)
@@ -260,19 +275,28 @@ class FluidSolver:
         return cell, u, gradp
 
     @_exchange
-    def advance(self, duration: float, steps: int = 1) -> float:
+    def advance(self, duration: float, steps: int = 1, heat: np.ndarray | None = None) -> float:
         """Advance the fluid by ``duration`` (s) in ``steps`` equal time steps with the
-        particle fields of the last :meth:`particle_forces`; returns the fluid time (s)."""
+        particle fields of the last :meth:`particle_forces`; returns the fluid time (s).
+        With the gas energy, ``heat`` (W per cell, default none) goes into each cell's gas
+        over the interval, and what entered through the boundaries adds to
+        ``boundary_heat`` (J)."""
         if duration <= 0 or steps < 1:
             raise ValueError(f"need duration > 0 and steps >= 1, got {duration}, {steps}")
+        if heat is not None and not self.energy:
+            raise ValueError("heat given to a fluid without gas energy (energy=False)")
+        heat = np.zeros(len(self._alpha)) if heat is None else np.asarray(heat, np.float64)
         head = (np.int32(ADVANCE).tobytes() + np.float64(duration / steps).tobytes()
                 + np.int32(steps).tobytes())
         for rank in range(self.nprocs):
             a, b = self.offsets[rank], self.offsets[rank + 1]
             self._send(rank, head + self._alpha[a:b].tobytes() + self._ksl[a:b].tobytes()
-                       + np.ascontiguousarray(self._us[a:b]).tobytes())
+                       + np.ascontiguousarray(self._us[a:b]).tobytes()
+                       + (heat[a:b].tobytes() if self.energy else b""))
         for rank in range(self.nprocs):
             self.time = float(self._read(rank, np.float64, 1)[0])
+            if self.energy:
+                self.boundary_heat += float(self._read(rank, np.float64, 1)[0])
         return self.time
 
     def couple(self, x, v, d, duration: float, steps: int = 1) -> np.ndarray:
@@ -281,6 +305,20 @@ class FluidSolver:
         forces = self.particle_forces(x, v, d)
         self.advance(duration, steps)
         return forces
+
+    @_exchange
+    def temperature(self) -> np.ndarray:
+        """Gas temperature (K) of every cell, in the order of ``cell_centres``."""
+        if not self.energy:
+            raise ValueError("no gas temperature: the fluid was started without energy")
+        for rank in range(self.nprocs):
+            self._send(rank, np.int32(TEMPERATURE).tobytes())
+        return np.concatenate([self._read(rank, np.float64, nc) for rank, nc in enumerate(self.rank_cells)])
+
+    def heat_capacity(self) -> np.ndarray:
+        """Heat capacity of each cell's gas, rho Cp alpha V (J/K), with the fraction last sent."""
+        return self.rho * self.cp * self._alpha * self.cell_volumes
+
 
     @_exchange
     def fields(self) -> tuple[np.ndarray, np.ndarray]:

@@ -125,3 +125,13 @@ def test_hot_cold_bed_smoke(tmp_path):
     fluid = reader.read()[0]
     alpha = fluid.point_data["alpha"]
     assert alpha.min() < 0.7 and alpha.max() == pytest.approx(1.0)   # a bed below, free air above
+
+
+def test_hot_cold_gas_bed_smoke_run_keeps_particles_and_gas_energy(tmp_path):
+    """cases/hot-cold-gas-bed -test (0.02 s): collisions and convection both move heat, and
+    particles plus gas keep their energy with what crossed the fluid's boundaries to 1e-12."""
+    _, summary = run_case("hot-cold-gas-bed", tmp_path, "--test")
+    assert summary["collisions"] > 1000 and summary["heat_moved"] > 0
+    assert summary["heat_convected_gross"] > 0
+    assert abs(summary["energy_balance_error"]) < 1e-12
+    assert abs(summary["total_energy_balance_error"]) < 1e-12

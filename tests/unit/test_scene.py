@@ -49,7 +49,8 @@ def test_valid_scene_loads_with_defaults(tmp_path):
     assert s.materials["steel"].dem.friction == 0.3             # default
     assert s.time.sample_every == 1 and s.fluid is None
     effects = s.effects_summary()
-    assert effects == dict(fluid_solver=False, contact_extraction=True, collision_heat=True,
+    assert effects == dict(fluid_solver=False, convection=False, particle_temperatures=True,
+                           contact_extraction=True, collision_heat=True,
                            restitution_feedback=False, enduring_conduction=False, wall_heat=True)
 
 
@@ -77,6 +78,11 @@ def test_dry_isothermal_scene_builds_nothing_extra(tmp_path):
     ("box = [0.0, 0.1,", "box = [0.2, 0.1,", "domain.box: each min must be below its max"),
     ("yield_stress = 300e6\n", "", "materials.steel.yield_stress: missing"),
     ("[effects]", "[effects]\nfluid = true", "fluid: missing section"),
+    ('contact_heat = "A"', 'contact_heat = "A"\nconvection = "wakao"',
+     "effects.convection: must be one of none, gunn, li_mason, ranz_marshall"),
+    ('contact_heat = "A"', 'contact_heat = "A"\nconvection = "gunn"', "effects.convection: needs the gas"),
+    ("[domain]", "[fluid]\nconductivity = 0.0\n\n[domain]", "fluid.conductivity: must be > 0"),
+    ("[domain]", "[fluid]\nheat_capacity = -5.0\n\n[domain]", "fluid.heat_capacity: must be > 0"),
     ("dem_step = 1e-6", "dem_step = nan", "time.dem_step: must be finite"),
 ])
 def test_mistakes_name_file_and_key(tmp_path, old, new, message):

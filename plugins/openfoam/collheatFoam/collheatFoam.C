@@ -25,6 +25,10 @@ Description
     bed (a 4-cell bed: 22 % below Ergun); this form gets a steady bed's drop right when
     its edges lie on faces (tests/engines/test_fluid.py, cases/packed-bed-ergun).
 
+    With -energy it also solves the gas temperature T (TEqn.H) with the particles' heat
+    Qgas as a source; Cp (J/(kg K)) and kappa (W/(m K)) of the gas come from
+    transportProperties, the boundary conditions from 0/T.
+
     Without -link it runs as a plain solver with alpha, Ksl, Us read from the start time
     (defaults 1, 0, 0). With -link DIR it serves a Python host (pyhost/openfoam.py) through
     two named pipes per rank, DIR/rank<N>.in and DIR/rank<N>.out; see hostLink.H.
@@ -46,6 +50,7 @@ int main(int argc, char *argv[])
         " coupled to a Python host through named pipes (-link)."
     );
     argList::addOption("link", "dir", "serve the Python host through pipes in dir");
+    argList::addBoolOption("energy", "solve the gas temperature T (Cp, kappa in transportProperties)");
 
     #include "setRootCaseLists.H"
     #include "createTime.H"
