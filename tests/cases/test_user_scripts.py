@@ -55,11 +55,15 @@ def test_debian_heat_transfer_tutorial_runs_unchanged(tmp_path):
     assert summary["inserted"] == 890 and summary["departed"] == 0
     assert summary["particle_particle"] > 1000 and summary["particle_wall"] > 100
     assert abs(summary["energy_balance_error"]) < 1e-12
-    # The script's own dump (custom/vtk, every 800 steps) at step 20000, just before the 'set':
-    # the spheres at x > 0 then are the ones set from ~300 K to 800 K.
-    import pyvista
-    frame = pyvista.read(case / "post" / "heatGran_20000.vtk")
-    T, x = np.asarray(frame.point_data["f_Temp[0]"]), np.asarray(frame.points)[:, 0]
+    # The script's own dumps (custom/vtk, every 800 steps) through the project's dump reader;
+    # at step 20000, just before the 'set', the spheres at x > 0 are the ones set to 800 K.
+    from pyhost.dumps import DumpReader
+    frames = {f.step: f for f in DumpReader([case / "post" / "heatGran_*.vtk"], dt=2.5e-5)}
+    steps = sorted(frames)
+    assert steps[-1] == 20800 and all(b - a == 800 for a, b in zip(steps[1:], steps[2:]))
+    assert len(frames[20800]) == 890 and frames[20800].time == pytest.approx(0.52)
+    frame = frames[20000]
+    T, x = frame["f_Temp[0]"], frame.positions()[:, 0]
     m_c = 8000 * 4 / 3 * math.pi * 0.004**3 * 10.0           # J/K per sphere
     half = x > 0
     print(f"{half.sum()} spheres set to 800 K; energy set by the script {summary['energy_set_by_script']:.6g} J")
