@@ -95,7 +95,7 @@ def pour_dumps(tmp_path_factory):
 # Tests that load LIGGGHTS into the pytest process itself. Debian's libliggghts brings
 # Debian's VTK into the global symbol scope, and pip's VTK (pyvista) then crashes reading a
 # legacy VTK file in the same process. So they run last, after every test that uses pyvista.
-IN_PROCESS_ENGINE = ("tests/engines/test_liggghts.py", "tests/engines/test_fluid.py",
+IN_PROCESS_ENGINE = ("tests/engines/test_liggghts.py",
                      "tests/cases/test_small_cases.py::test_results_so_far_survive_a_failure")
 
 
