@@ -159,7 +159,7 @@ def render_particles(out: Path) -> Path:
     bar = dict(vertical=True, width=0.05, height=0.5, position_y=0.25, title_font_size=14, label_font_size=14)
     title = f"temperature change [{unit}]"
     plotter.add_mesh(spheres, scalars="change", cmap="coolwarm", clim=clim,
-                     scalar_bar_args=dict(bar, title=title + "\n", position_x=0.88, fmt="%.3g")
+                     scalar_bar_args=dict(bar, title=f"T change [{unit}]\n", position_x=0.86, fmt="%.3g")
                      if has_fluid else {"title": title})
     if has_fluid:
         x0, x1, y0, y1, z0, z1 = grid.bounds
