@@ -266,9 +266,9 @@ class Coupling:
         """The DEM's Hertz law between atom types a and b, from the script's own values
         (LIGGGHTS' effective modulus and per-pair restitution); read once per pair."""
         if (a, b) not in self.laws:
-            E = [self.dem.lmp.fix_global(self.dem.info.globals["youngsModulus"], t - 1) for t in (a, b)]
-            nu = [self.dem.lmp.fix_global(self.dem.info.globals["poissonsRatio"], t - 1) for t in (a, b)]
-            e = self.dem.lmp.fix_global(self.dem.info.globals["coefficientRestitution"], a - 1, b - 1)
+            E = self.dem.type_values("youngsModulus", (a, b))
+            nu = self.dem.type_values("poissonsRatio", (a, b))
+            e = self.dem.type_pair_value("coefficientRestitution", a, b)
             self.laws[a, b] = DemHertz(1.0 / ((1 - nu[0] ** 2) / E[0] + (1 - nu[1] ** 2) / E[1]), e)
         return self.laws[a, b]
 
@@ -276,7 +276,7 @@ class Coupling:
         """A script's fix heat/gran integrates Temp with its own thermalCapacity: it must be the
         scene's heat capacity of each type's material, else the two would disagree on energy."""
         types = np.flatnonzero(self.type_material >= 0)
-        script = self.dem.type_values("thermalCapacity", int(types.max()))[types - 1]
+        script = self.dem.type_values("thermalCapacity", types)
         scene = self.capacity[self.type_material[types]]
         bad = np.flatnonzero(np.abs(script / scene - 1) > 1e-12)
         if len(bad):

@@ -65,7 +65,7 @@ def start_fluid(scene, folder: Path):
     return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy).start()
 
 
-def box_world(scene, out: Path, fluid_force: bool, start=None):
+def box_world(scene, out: Path, start=None):
     """The generated DEM of a box scene: its script (run for time.end) and how the host sees
     its particles: one atom type per material, groups = the [[particles]] tables, walls
     ``wall<k>`` = the scene's [[walls]]. ``start``: the particles (``pyhost.dem_input.Particles``,
@@ -160,7 +160,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         if scene.time.dem_step > t_c / 20:
             print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
                   f"({t_c:.3g} s) with fewer than 20 steps")
-        script, particles = box_world(scene, out, effects["fluid_solver"], start)
+        script, particles = box_world(scene, out, start)
         variables = {}
     commands = read_script(script, scene.folder)
     fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None

@@ -80,8 +80,6 @@ class Dem:
         self.lmp = Liggghts(Path(workdir).resolve(), variables=variables)
         self.info = ScriptInfo()
         self.log = log
-        self.prepared = False
-        self.fluid_force = False
         self.pair_cols = self.wall_cols = None
         self._warned_mesh = False
 
@@ -132,7 +130,6 @@ class Dem:
         if fluid_force:         # the set-up added fix external's array while it was uninitialised
             self.lmp.external_force(FLUID_FIX)[:] = 0.0     # memory: zero it and set up again
             self.lmp.command("run 0")
-        self.fluid_force, self.prepared = fluid_force, True
         return added
 
     def run(self, steps: int) -> None:
@@ -166,19 +163,20 @@ class Dem:
         self.lmp.external_force(FLUID_FIX)[:] = force
 
     # -- the DEM's own values -----------------------------------------------------------
-    def type_values(self, prop: str, ntypes: int) -> np.ndarray:
+    def type_values(self, prop: str, types) -> np.ndarray:
         """A per-type property/global of the script (youngsModulus, poissonsRatio,
-        thermalCapacity, ...), by type (index 0 = type 1)."""
-        fix = self.info.globals.get(prop)
-        if fix is None:
-            raise ScriptError(f"the script sets no 'fix ... property/global {prop} peratomtype ...'")
-        return np.array([self.lmp.fix_global(fix, k) for k in range(ntypes)])
+        thermalCapacity, ...) for these atom types (from 1)."""
+        return np.array([self.lmp.fix_global(self._global_fix(prop), int(t) - 1) for t in types])
 
-    def type_pair_values(self, prop: str, ntypes: int) -> np.ndarray:
+    def type_pair_value(self, prop: str, a: int, b: int) -> float:
+        """A per-type-pair property/global of the script (coefficientRestitution, ...)."""
+        return self.lmp.fix_global(self._global_fix(prop), a - 1, b - 1)
+
+    def _global_fix(self, prop: str) -> str:
         fix = self.info.globals.get(prop)
         if fix is None:
-            raise ScriptError(f"the script sets no 'fix ... property/global {prop} peratomtypepair ...'")
-        return np.array([[self.lmp.fix_global(fix, a, b) for b in range(ntypes)] for a in range(ntypes)])
+            raise ScriptError(f"the script sets no 'fix ... property/global {prop} ...', which the host needs")
+        return fix
 
     # -- contacts ---------------------------------------------------------------------
     def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:

@@ -175,3 +175,16 @@ def test_silo_with_the_users_openfoam_case(tmp_path):
     drop = float(rows[-1]["pressure_drop"])
     assert math.isfinite(drop) and drop > 0                 # the settled bed resists the gas
     assert (case / "out" / "vtk" / "fluid.pvd").exists()
+
+
+def test_heat_capacity_differing_from_the_scripts_heat_gran_is_refused(tmp_path):
+    """heat/gran integrates Temp with the script's thermalCapacity, the collisions with the
+    scene's heat_capacity: if they differ the energies disagree, so the run stops at once."""
+    case = tmp_path / "silo-heat"
+    shutil.copytree(ROOT / "cases" / "silo-heat", case, ignore=shutil.ignore_patterns("output", "post", "log.*"))
+    (case / "post").mkdir()
+    text = (case / "case.toml").read_text()
+    (case / "case.toml").write_text(text.replace("heat_capacity = 840.0", "heat_capacity = 800.0"))
+    r, _ = run(case, "--test")
+    assert r.returncode == 2
+    assert "atom type 2" in r.stderr and "thermalCapacity 840" in r.stderr and "heat_capacity 800" in r.stderr

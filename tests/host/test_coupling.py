@@ -42,7 +42,7 @@ from pyhost.engines.dem import Dem
 from pyhost.scene import load_scene
 from pyhost.script import read_script
 case = Path(sys.argv[1])
-script, _ = box_world(load_scene(case), case.parent / "ref", False)
+script, _ = box_world(load_scene(case), case.parent / "ref")
 dem = Dem(case.parent / "ref" / "dem")
 commands = read_script(script)
 for cmd in commands[:-1]:

@@ -28,7 +28,7 @@ g, dt = np.array(scene.domain.gravity), scene.time.dem_step
 result = []
 for k in range(4):
     out = Path(sys.argv[2]) / f"run{k}"
-    script, _ = box_world(scene, out, True)
+    script, _ = box_world(scene, out)
     dem = Dem(out / "dem")
     for cmd in read_script(script)[:-1]:
         dem.command(cmd)
