@@ -96,7 +96,6 @@ def pour_dumps(tmp_path_factory):
 # Debian's VTK into the global symbol scope, and pip's VTK (pyvista) then crashes reading a
 # legacy VTK file in the same process. So they run last, after every test that uses pyvista.
 IN_PROCESS_ENGINE = ("tests/engines/test_liggghts.py",
-                     "tests/host/test_coupling.py::test_contacts_present_at_a_restart_are_not_collisions",
                      "tests/cases/test_small_cases.py::test_results_so_far_survive_a_failure")
 
 

@@ -112,17 +112,15 @@ class Recording:
         return getattr(self.dem, name)
 
 
-@pytest.mark.parametrize("touching", [False, True])
-def test_contacts_present_at_a_restart_are_not_collisions(tmp_path, touching):
-    # a run started from given particles (a restart): two spheres already in contact (10 um
-    # overlap, at rest) are a contact that was there, not a collision; the same spheres apart
-    # and closing in at 0.4 m/s collide as in the scene
+def restart_run(workdir, touching: bool) -> list:
+    """A run started from given particles (a restart) of the two-spheres scene: collisions,
+    heat moved [J], final velocities [m/s] (by id)."""
     import dataclasses
 
     from pyhost.commands.run import simulate
     from pyhost.dem_input import place_particles
 
-    case = tmp_path / "case.toml"
+    case = Path(workdir) / "case.toml"
     case.write_text(TWO)
     scene = load_scene(case)
     scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=1e-3))
@@ -131,9 +129,23 @@ def test_contacts_present_at_a_restart_are_not_collisions(tmp_path, touching):
         start = dataclasses.replace(start, position=start.position + [[0, 0, 0], [-2.1e-4, 0, 0]],
                                     velocity=0.0 * start.velocity)
     dem = {}
-    summary = simulate(scene, tmp_path / "out", progress_every=1e9, start=start,
+    summary = simulate(scene, Path(workdir) / "out", progress_every=1e9, start=start,
                        wrap=lambda d: dem.setdefault("d", Recording(d)))
-    assert summary["collisions"] == (0 if touching else 1)
-    assert (summary["heat_moved"] == 0.0) if touching else (summary["heat_moved"] > 0)
-    v = dem["d"].v
+    return [summary["collisions"], summary["heat_moved"], dem["d"].v.tolist()]
+
+
+@pytest.mark.parametrize("touching", [False, True])
+def test_contacts_present_at_a_restart_are_not_collisions(tmp_path, touching):
+    """Two spheres already in contact (10 um overlap, at rest) at a restart are a contact that
+    was there, not a collision; the same spheres apart and closing in at 0.4 m/s collide as in
+    the scene. Run in a fresh process, like every engine of these tests."""
+    code = ("import json, sys; sys.path.insert(0, sys.argv[1]); import test_coupling as t; "
+            "print(json.dumps(t.restart_run(sys.argv[2], sys.argv[3] == '1')))")
+    r = subprocess.run([sys.executable, "-c", code, str(Path(__file__).parent), str(tmp_path),
+                        "1" if touching else "0"], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+    collisions, heat_moved, v = json.loads(r.stdout.strip().splitlines()[-1])
+    v = np.array(v)
+    assert collisions == (0 if touching else 1)
+    assert (heat_moved == 0.0) if touching else (heat_moved > 0)
     assert np.isfinite(v).all() and v[0, 0] < 0 < v[1, 0]      # apart again (with restitution feedback on)
