@@ -34,7 +34,9 @@ is refused until it is.
 from __future__ import annotations
 
 import argparse
+import csv
 import gzip
+import json
 import re
 import shutil
 import subprocess
@@ -119,8 +121,6 @@ def dpmfoam(case: Path, end: float, np: int) -> dict:
 
 def host(folder: Path, end: float, np: int) -> dict:
     """``python -m pyhost run`` on a copy of bed-25k running ``end`` seconds."""
-    if np > 1 and not HOST_MPI:
-        raise SystemExit("--np > 1: the host's MPI run (mpirun -np N python -m pyhost run) is not available yet")
     case = folder / "case"
     case.mkdir(parents=True)
     text = (CASE / "case.toml").read_text()
@@ -133,10 +133,11 @@ def host(folder: Path, end: float, np: int) -> dict:
     wall, _ = run_logged([*mpirun(np), sys.executable, "-m", "pyhost", "run", str(case), "--out", str(folder / "output")],
                       ROOT, log)
     rates = re.findall(r"([0-9.eE+-]+) s simulated per s", log.read_text())
-    summary = (folder / "output" / "summary.json").read_text()
-    collisions = int(re.search(r'"collisions": (\d+)', summary).group(1))
-    particles = int(re.search(r"^[^,]+,(\d+),", (folder / "output" / "history.csv").read_text().splitlines()[-1]).group(1))
-    return dict(total=wall, march=1.0 / float(rates[-1]), collisions=collisions, particles=particles)
+    summary = json.loads((folder / "output" / "summary.json").read_text())
+    with open(folder / "output" / "history.csv") as f:
+        last = list(csv.DictReader(f))[-1]
+    return dict(total=wall, march=1.0 / float(rates[-1]), collisions=summary["collisions"],
+                particles=int(last["particles"]))
 
 
 def main(argv=None) -> int:
