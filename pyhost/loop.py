@@ -162,7 +162,7 @@ class Coupling:
                 self.before = (self.t, a.id.copy(), a.x.copy(), a.v.copy())
             self.dem.run(chunk)
             signals.check()
-            if self.keep_all is not None and self.dem.lmp.nlocal < len(self.before[1]):
+            if self.keep_all is not None and self.dem.count() < len(self.before[1]):
                 self.lost()
             n -= chunk
             self.steps += chunk

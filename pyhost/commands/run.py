@@ -140,11 +140,12 @@ def user_script(scene):
 
 
 def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None, wrap_fluid=None,
-             start=None) -> dict:
+             start=None, link=None) -> dict:
     """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
     world, with the fluid if the scene has one. ``wrap(dem)`` and ``wrap_fluid(fluid)`` may
     stand in front of the engines (tests inject faults, benchmarks record with them);
-    ``start``: the particles a box scene starts from (see ``box_world``). Returns the summary."""
+    ``start``: the particles a box scene starts from (see ``box_world``); ``link``: the
+    other MPI ranks' LIGGGHTS (``pyhost.engines.ranks``), None when serial. Returns the summary."""
     from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
     from pyhost.loop import run_scene
@@ -167,14 +168,14 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     cwd = os.getcwd()
     try:
         os.chdir(scene.folder)          # the script's relative paths, as with 'liggghts -in' there
-        dem = Dem(out / "dem", variables=variables)
+        dem = Dem(out / "dem", variables=variables, link=link)
         try:
             return run_scene(scene, wrap(dem) if wrap else dem, commands, out, max_time=max_time,
                              fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
                              end=None if scene.scripted else scene.time.end, progress_every=progress_every,
                              **particles)
         finally:
-            dem.lmp.close()
+            dem.close()
     finally:
         os.chdir(cwd)
         if fluid is not None:
@@ -182,6 +183,21 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
 
 
 def run(args) -> int:
+    """Serial, or rank 0 under mpirun (the other ranks follow: ``pyhost.engines.ranks``)."""
+    from pyhost.engines.ranks import Follower, Link, world
+
+    comm = world()
+    if comm is not None and comm.Get_rank() != 0:
+        return Follower(comm).serve()
+    link = Link(comm) if comm is not None else None
+    try:
+        return run_case(args, link)
+    finally:
+        if link is not None:
+            link.close()
+
+
+def run_case(args, link) -> int:
     from pyhost.outdir import prepare_output, write_atomic
     from pyhost.scene import load_scene
 
@@ -195,7 +211,9 @@ def run(args) -> int:
     print("scene:", json.dumps(resolved(scene), indent=1, default=str))
     print("active effects:", ", ".join(k for k, on in effects.items() if on) or "none (plain DEM)")
     write_atomic(out / "scene.json", json.dumps(resolved(scene), indent=1, default=str))
-    summary = simulate(scene, out, test=args.test)
+    if link is not None:
+        print(f"MPI: LIGGGHTS on {link.size} ranks; the host on rank 0")
+    summary = simulate(scene, out, test=args.test, link=link)
     print("summary:", json.dumps(summary, indent=1))
     if scene.output.pictures:        # own process: see pyhost/commands/pictures.py
         drawn = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(out)])

@@ -56,6 +56,8 @@ def _exchange(method):
 def foam_env() -> dict:
     """Environment for Debian's OpenFOAM v1912 binaries and OpenMPI as root."""
     env = dict(os.environ)
+    if "OMPI_COMM_WORLD_SIZE" in env:   # a host started by mpirun: the solver (or its own mpirun)
+        env = {k: v for k, v in env.items() if not k.startswith(("OMPI_", "PMIX_", "PMI_", "OPAL_"))}  # is a job of its own
     env.setdefault("WM_PROJECT_DIR", "/usr/share/openfoam")
     env.setdefault("USER", "root")
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
