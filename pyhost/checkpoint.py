@@ -117,7 +117,7 @@ def refuse(scene) -> str | None:
         return ("a scene with its own LIGGGHTS script ([dem] script) cannot be restarted yet: the host would have "
                 "to rewrite the user's script (read_restart in place of its box, regions and insertion, with "
                 "every fix re-issued under its id); see docs/checkpoint.md")
-    if scene.fluid is not None:
+    if scene.effects.fluid:
         return ("a scene with a fluid cannot be restarted yet: the fluid's time directory and the fluid force of "
                 "the last coupling are not part of a checkpoint; see docs/checkpoint.md")
     return None

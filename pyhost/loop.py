@@ -232,8 +232,7 @@ class Coupling:
         for name in ("t0_step", "steps", "t", "CT0", "gas_energy0"):
             setattr(self, name, state[name])
         self.totals, self.warned = state["totals"], set(state["warned"])
-        self.tracker.open_keys = state["open_keys"]
-        self.tracker._sorted = np.sort(state["open_keys"])
+        self.tracker.update(state["open_keys"])
         self.open = {k: (*v[:4].tolist(), v[4:].tolist())
                      for k, v in zip(state["contact_keys"].tolist(), state["contact_info"])}
         self.CT_by_id, self.seen = state["CT_by_id"], state["seen"]
@@ -581,7 +580,10 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     except BaseException as exc:          # keep what was computed: summary of the run so far
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
                 and coupling.every["checkpoint"]:
-            checkpoint.write(coupling)
+            try:
+                checkpoint.write(coupling)
+            except Exception as err:      # the stop goes on: summary, engines closed, exit 128 + n
+                log(f"warning: no checkpoint at the stop ({type(err).__name__}: {err}); the last one stays")
         if coupling is not None:
             coupling.finish(status=f"stopped at t = {coupling.t:g} s by {type(exc).__name__}: {exc}")
         raise
