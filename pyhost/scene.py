@@ -218,6 +218,9 @@ class Output:
     every: float = spec(">0", 1e-3, "interval between VTK frames [s]")
     vtk: bool = spec(default=True, doc="write VTK time series")
     pictures: bool = spec(default=True, doc="write PNG pictures")
+    checkpoint: float = spec(">=0", 0.0, "simulated time between checkpoints into OUT/checkpoint, also written "
+                             "when a signal stops the run; continue with 'run CASE --restart' [s]; 0: none. "
+                             "Box scenes without fluid only (docs/checkpoint.md)")
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ import numpy as np
 
 from pyhost.collisions import WALL_BASE
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
-from pyhost.engines.ranks import local_atoms, write_local
+from pyhost.engines.ranks import local_atoms, local_values, put_by_id, write_local
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 
 FLUID_FIX = "collheat_fluid"
@@ -226,6 +226,24 @@ class Dem:
                   for k in names]
         self.link.order("write", FLUID_FIX)
         write_local(self.lmp, *self.link.scatter(list(zip(*pieces))), force_fix=FLUID_FIX)
+
+    def per_atom(self, names) -> tuple:
+        """Copies of per-atom arrays (``Liggghts.atom`` names, e.g. id, f, torque) of all atoms,
+        in the order of ``atoms()``."""
+        if self.link is None:
+            return local_values(self.lmp, names)
+        self._order("per_atom", tuple(names))
+        parts = self.link.gather(local_values(self.lmp, names))
+        return tuple(np.concatenate([p[k] for p in parts]) for k in range(len(names)))
+
+    def put_per_atom(self, ids, **arrays) -> None:
+        """Per-atom arrays given for all atoms by id (e.g. f=..., torque=...) into LIGGGHTS."""
+        self._order("put", ids, arrays)
+        put_by_id(self.lmp, ids, arrays)
+
+    def engine_command(self, line: str) -> None:
+        """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""
+        self._raw(line)
 
     def add_velocity(self, local_index, dv) -> None:
         """Add dv [m/s] to the velocity of these atoms (indices into the last ``atoms()``)."""

@@ -61,7 +61,7 @@ _HELPER_DECLARATIONS = {
 # Per-atom arrays: name -> (ctype, columns; 0 for a vector).
 _ATOM = {
     "x": (_c.c_double, 3), "v": (_c.c_double, 3), "f": (_c.c_double, 3),
-    "omega": (_c.c_double, 3), "radius": (_c.c_double, 0), "rmass": (_c.c_double, 0),
+    "omega": (_c.c_double, 3), "torque": (_c.c_double, 3), "radius": (_c.c_double, 0), "rmass": (_c.c_double, 0),
     "id": (_c.c_int, 0), "type": (_c.c_int, 0),
 }
 

@@ -44,6 +44,24 @@ def local_atoms(lmp, temperature: bool) -> tuple:
     return tuple(parts)
 
 
+def local_values(lmp, names) -> tuple:
+    """Copies of these per-atom arrays of this rank's atoms (``Liggghts.atom`` names)."""
+    return tuple(lmp.atom(name).copy() for name in names)
+
+
+def put_by_id(lmp, ids, arrays: dict) -> None:
+    """Per-atom values given for all atoms by id: this rank's atoms take theirs."""
+    here = lmp.atom("id").astype(np.int64)
+    ids = np.asarray(ids, np.int64)
+    lookup = np.full(int(max(ids.max(initial=0), here.max(initial=0))) + 1, -1, np.int64)
+    lookup[ids] = np.arange(len(ids))
+    rows = lookup[here]
+    if np.any(rows < 0):
+        raise ValueError(f"{int(np.sum(rows < 0))} atoms of LIGGGHTS are not among the ids given")
+    for name, values in arrays.items():
+        lmp.atom(name)[:] = np.asarray(values)[rows]
+
+
 def write_local(lmp, T=None, v=None, force=None, force_fix: str | None = None) -> None:
     """This rank's own slice of what the host changed, in the local order it sent."""
     if T is not None and len(T):
@@ -87,6 +105,9 @@ class Follower:
         self.comm, self.lmp = comm, None
 
     def serve(self) -> int:
+        import signal
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):     # rank 0 stops the run and
+            signal.signal(sig, signal.SIG_IGN)                         # then releases the followers
         while True:
             name, args = self.comm.bcast(None, root=ROOT)
             if name == "close":
@@ -117,6 +138,12 @@ class Follower:
 
     def do_local(self, compute_id) -> None:
         self.comm.gather(self.lmp.local_array(compute_id), root=ROOT)
+
+    def do_per_atom(self, names) -> None:
+        self.comm.gather(local_values(self.lmp, names), root=ROOT)
+
+    def do_put(self, ids, arrays) -> None:
+        put_by_id(self.lmp, ids, arrays)
 
     def do_write(self, force_fix) -> None:
         write_local(self.lmp, *self.comm.scatter(None, root=ROOT), force_fix=force_fix)

@@ -70,3 +70,39 @@ def test_granular_gas_on_two_ranks(tmp_path):
     rows = list(csv.DictReader(open(tmp_path / "np2" / "collisions.csv")))
     keys = {(min(int(r["i"]), int(r["j"])), max(int(r["i"]), int(r["j"])), r["time"]) for r in rows}
     assert len(keys) == len(rows) == parallel["collisions"]        # each collision once, not once per rank
+
+
+STOPPER = """
+import os, signal, sys
+import pyhost.commands.run as r
+from pyhost.cli import main
+at = int(sys.argv[1])
+class Stopping:
+    def __init__(self, dem): self.dem = dem
+    def run(self, n):
+        self.dem.run(n)
+        if self.dem.step >= at: os.kill(os.getpid(), signal.SIGKILL)
+    def __getattr__(self, name): return getattr(self.dem, name)
+simulate = r.simulate
+r.simulate = lambda *a, **k: simulate(*a, wrap=Stopping, **k)
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
+    """hot-cold-box --test on two ranks with a checkpoint every 4 ms, rank 0 killed outright at
+    step 6003 (mpirun ends the job) and continued with --restart on two ranks: collisions.csv,
+    history.csv and the summary are those of the two-rank run never stopped, bit for bit."""
+    case = tmp_path / "box"
+    shutil.copytree(CASES / "hot-cold-box", case, ignore=shutil.ignore_patterns("output", "log.*"))
+    (case / "case.toml").write_text((case / "case.toml").read_text() + "\ncheckpoint = 0.004\npictures = false\n")
+    whole = run(case, tmp_path / "whole", 2, "--test")
+    mpirun = ["mpirun", "--oversubscribe", "-np", "2", sys.executable]
+    cut = subprocess.run(mpirun + ["-c", STOPPER, "6003", "run", str(case), "--test", "--out", str(tmp_path / "cut")],
+                         capture_output=True, text=True, env=ENV, timeout=600)
+    assert cut.returncode != 0 and not (tmp_path / "cut" / "summary.json").exists()
+    assert (tmp_path / "cut" / "checkpoint" / "manifest.json").is_file()
+    restarted = run(case, tmp_path / "cut", 2, "--test", "--restart")
+    assert restarted == whole
+    for name in ("collisions.csv", "history.csv"):
+        assert (tmp_path / "cut" / name).read_bytes() == (tmp_path / "whole" / name).read_bytes(), name
