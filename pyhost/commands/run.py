@@ -51,7 +51,7 @@ def start_fluid(scene, folder: Path):
         if energy:                      # the gas's properties are the scene's, given once
             FoamFile(folder / "constant" / "transportProperties").update({"Cp": f.heat_capacity,
                                                                            "kappa": f.conductivity})
-        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy).start()
+        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
@@ -63,8 +63,8 @@ def start_fluid(scene, folder: Path):
                     nu=f.viscosity / f.density, gravity=scene.domain.gravity,
                     dt=scene.time.couple_every * scene.time.dem_step,
                     T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
-                    T_inlet=f.inlet_temperature or f.temperature, T_walls=sides)
-    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy).start()
+                    T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
+    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
 
 
 def box_world(scene, out: Path, start=None, restart: Path | None = None):

@@ -159,6 +159,26 @@ def test_serial_and_two_ranks_agree(tmp_path):
     assert np.abs(f1 - f2).max() <= 1e-6 * np.abs(f1).max()
 
 
+def test_a_rank_without_particles_does_not_hang_the_others(tmp_path):
+    """The lid box split in z (1 x 1 x 2) with every particle in the lower part: the upper rank
+    finds none (it used to leave the lower one waiting at the first locate for the tet base
+    points findCell synchronises across processor faces). Forces as serially, to 1e-6."""
+    from foamlib import FoamFile
+
+    rng = np.random.default_rng(10009)
+    x = rng.uniform((0.002, 0.001, 0.002), (0.038, 0.009, 0.015), (100, 3))
+    v = rng.normal(0, 0.05, (100, 3))
+    forces = []
+    for nprocs in (1, 2):
+        case = lid_box(tmp_path / f"np{nprocs}", nprocs)
+        FoamFile(case / "system" / "decomposeParDict")["coeffs"] = {"n": [1, 1, nprocs]}
+        with FluidSolver(case, nprocs=nprocs, drag="difelice", timeout=60) as fluid:
+            for _ in range(5):
+                force = fluid.couple(x, v, 1e-3, 5e-3)
+            forces.append(force)
+    assert np.abs(forces[1] - forces[0]).max() <= 1e-6 * np.abs(forces[0]).max()
+
+
 def test_diverging_run_raises_with_the_solver_message(tmp_path):
     """Inflow of 50 m/s through 1 mm cells with a 1 s step: the run blows up; the host
     gets FluidError with the log's end and goes on (it can start another solver)."""
