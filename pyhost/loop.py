@@ -171,9 +171,8 @@ class Coupling:
         while n > 0:
             step = self.dem.step - self.t0_step
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
-            if self.keep_all is not None:
-                a = self.dem.atoms(False)
-                self.before = (self.t, a.id.copy(), a.x.copy(), a.v.copy())
+            if self.keep_all is not None and (self.before is None or self.before[4] != self.dem.step):
+                self.note_before(self.dem.atoms(False))
             self.dem.run(chunk)
             if self.keep_all is not None and self.dem.count() < len(self.before[1]):
                 self.lost()
@@ -186,6 +185,8 @@ class Coupling:
                 atoms = self.dem.atoms(self.heat)
                 self.track_particles(atoms)
                 self.sample_contacts(atoms)
+                if self.keep_all is not None:
+                    self.note_before(atoms)         # spares a gather of all atoms under MPI
             if due["couple"]:
                 self.couple_fluid()
             if due["frame"]:
@@ -197,10 +198,15 @@ class Coupling:
         if self.heat:
             self.track_particles(self.dem.atoms(True))
 
+    def note_before(self, atoms) -> None:
+        """The particles before the next chunk (time, ids, positions, velocities, step): what
+        a report of lost particles says of them."""
+        self.before = (self.t, atoms.id.copy(), atoms.x.copy(), atoms.v.copy(), self.dem.step)
+
     def lost(self):
         """A box scene lost particles (through an open face, a soft wall, or blown out)."""
         gone = np.setdiff1d(self.before[1], self.dem.atoms(False).id)
-        raise particles_lost(self.scene, gone, self.before, self.dem.step * self.dem.dt, self.keep_all)
+        raise particles_lost(self.scene, gone, self.before[:4], self.dem.step * self.dem.dt, self.keep_all)
 
     def resync(self) -> None:
         """Before each run: heat content that the script's own commands changed since the last

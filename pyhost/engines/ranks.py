@@ -17,6 +17,7 @@ domain decomposition, ghost exchange and migration are LIGGGHTS'.
 from __future__ import annotations
 
 import os
+import time
 
 import numpy as np
 
@@ -83,6 +84,7 @@ class Link:
     def order(self, name: str, *args) -> None:
         if self.closed:
             raise RuntimeError(f"MPI order '{name}' after the other ranks were released")
+        self.comm.Ibarrier().Wait()        # the followers wait in theirs (see Follower.next)
         self.comm.bcast((name, args), root=ROOT)
 
     def gather(self, mine):
@@ -109,12 +111,23 @@ class Follower:
         for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):     # rank 0 stops the run and
             signal.signal(sig, signal.SIG_IGN)                         # then releases the followers
         while True:
-            name, args = self.comm.bcast(None, root=ROOT)
+            name, args = self.next()
             if name == "close":
                 if self.lmp is not None:
                     self.lmp.close()
                 return 0
             getattr(self, "do_" + name)(*args)
+
+    def next(self):
+        """Rank 0's next order. While rank 0 works alone (the plugin, output, the fluid solver),
+        this rank waits in a non-blocking barrier, testing it with growing pauses (to 1 ms):
+        a blocking MPI call would poll and take a core from the engines."""
+        req, pause, spun = self.comm.Ibarrier(), 0.0, time.perf_counter()
+        while not req.Test():
+            if time.perf_counter() - spun > 1e-3:          # a short busy spell first: orders come in bursts
+                pause = min(max(2 * pause, 2e-5), 1e-3)
+                time.sleep(pause)
+        return self.comm.bcast(None, root=ROOT)
 
     def do_open(self, cwd, workdir, variables) -> None:
         from pyhost.engines.liggghts import Liggghts
