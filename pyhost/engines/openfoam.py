@@ -195,6 +195,7 @@ class FluidSolver:
                 for rank in range(self.nprocs):
                     self._read(rank, np.float64, 1)
                 self.proc.wait(timeout=self.timeout)
+                self._reconstruct()
         finally:
             for fds in self._fds:
                 for fd in fds:
@@ -203,6 +204,13 @@ class FluidSolver:
             self._kill()
             self.proc = None
             shutil.rmtree(self.case / ".link", ignore_errors=True)
+
+    def _reconstruct(self) -> None:
+        """A decomposed run's written times (``write()``) as whole fields in the case, as a
+        serial run leaves them (reconstructPar, for the times not reconstructed yet)."""
+        if self.nprocs > 1 and any(p.name != "0" and p.name[0].isdigit()
+                                   for p in (self.case / "processor0").iterdir()):
+            run_utility(self.case, "reconstructPar", "-newTimes")
 
     def _kill(self) -> None:
         """SIGKILL the solver's session (also stopped processes and mpirun's ranks) and reap it."""

@@ -147,6 +147,9 @@ def test_serial_and_two_ranks_agree(tmp_path):
             p, u = fluid.fields()
             order = np.lexsort(np.round(fluid.cell_centres, 9).T)  # same order for both
             results.append((force, p[order], u[order], fluid.rank_cells))
+            written = fluid.write()
+        # the decomposed run's written time is reconstructed into the case, as a serial run leaves it
+        assert (tmp_path / f"np{nprocs}" / f"{written:g}" / "U").is_file()
     (f1, p1, u1, _), (f2, p2, u2, ranks) = results
     assert len(ranks) == 2 and min(ranks) > 0
     u_scale, p_scale = np.abs(u1).max(), np.ptp(p1)
