@@ -12,8 +12,12 @@ count the coupled run from its first DEM step, not the engines' set-up. Each (N,
 runs in a fresh process (a fresh ``mpirun``); the rows come from one run of this script.
 Compare them as ratios: the machine may be shared.
 
+With ``--case CASE`` (e.g. cases/bed-25k): that case as it is (fluid included) for ``--time``
+s, heat as its scene says against none, with the share of OpenFOAM (collheatFoam's
+exchanges and steps, timed on rank 0) beside LIGGGHTS' and the host's.
+
 Run: .venv/bin/python tools/bench_scaling.py [--particles 1000 10000 100000] [--ranks 1 2]
-     [--time 2e-4] [--repeat 1]
+     [--time 2e-4] [--repeat 1] [--case cases/bed-25k]
 """
 from __future__ import annotations
 
@@ -52,8 +56,30 @@ class Timed:
         self.in_dem += time.perf_counter() - t
 
 
+class TimedFluid:
+    """The fluid solver as the loop sees it: the time inside its exchanges and steps."""
+
+    def __init__(self, fluid):
+        self.fluid, self.inside = fluid, 0.0
+
+    def __getattr__(self, name):
+        attr = getattr(self.fluid, name)
+        if name not in ("particle_forces", "advance", "fields", "temperature"):
+            return attr
+
+        def timed(*args, **kwargs):
+            t = time.perf_counter()
+            try:
+                return attr(*args, **kwargs)
+            finally:
+                self.inside += time.perf_counter() - t
+        return timed
+
+
 def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
-    """One run (under mpirun or not); rank 0 prints one JSON line."""
+    """One run (under mpirun or not); rank 0 prints one JSON line. ``n`` > 0: the grown gas
+    with ``n`` particles; ``n`` = 0: the case in the environment variable BENCH_CASE as it is,
+    for ``sim_time`` s."""
     from pyhost.commands.run import simulate
     from pyhost.engines.ranks import Follower, Link, world
     from pyhost.scene import load_scene
@@ -65,15 +91,23 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
         comm.gather(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, root=0)
         return
     link = Link(comm) if comm is not None else None
-    scene = variant(scaled(load_scene(CASE), n), sim_time, contact_heat=heat, heat_path="fast")
+    if n:
+        scene = variant(scaled(load_scene(CASE), n), sim_time, contact_heat=heat, heat_path="fast")
+    else:
+        base = load_scene(Path(os.environ["BENCH_CASE"]).resolve() / "case.toml")
+        scene = variant(base, sim_time, contact_heat=heat)
     timed = {}
 
     def wrap(dem):
         timed["dem"] = Timed(dem)
         return timed["dem"]
 
+    def wrap_fluid(fluid):
+        timed["fluid"] = TimedFluid(fluid)
+        return timed["fluid"]
+
     try:
-        summary = simulate(scene, out.resolve(), progress_every=1e9, wrap=wrap, link=link)
+        summary = simulate(scene, out.resolve(), progress_every=1e9, wrap=wrap, wrap_fluid=wrap_fluid, link=link)
         end = time.perf_counter()
     finally:
         if link is not None:
@@ -84,15 +118,17 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
     d = timed["dem"]
     print(json.dumps(dict(particles=sum(g.count for g in scene.particles), ranks=len(rss),
                           steps=summary["steps"], wall=end - d.started, in_dem=d.in_dem,
+                          in_fluid=timed["fluid"].inside if "fluid" in timed else 0.0,
                           collisions=summary["collisions"], rss_max_mb=max(rss) / 1024, rss_sum_mb=sum(rss) / 1024,
                           balance=summary.get("energy_balance_error"))))
 
 
-def measure(n: int, ranks: int, sim_time: float, heat: str, tmp: Path) -> dict:
+def measure(n: int, ranks: int, sim_time: float, heat: str, tmp: Path, case: Path | None = None) -> dict:
     cmd = [sys.executable, __file__, "--worker", str(n), str(sim_time), heat, str(tmp / f"{heat}-{n}-{ranks}")]
     if ranks > 1:
         cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
-    done = subprocess.run(cmd, env=ENV, capture_output=True, text=True)
+    env = dict(ENV, BENCH_CASE=str(case)) if case else ENV
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True)
     if done.returncode != 0:
         raise SystemExit(f"run failed: {' '.join(cmd)}\n{done.stdout[-2000:]}{done.stderr[-2000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
@@ -104,12 +140,16 @@ def main() -> None:
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--time", type=float, default=2e-4, help="simulated time per run [s] (DEM step 1e-6 s)")
     ap.add_argument("--repeat", type=int, default=1, help="runs of each (best of)")
+    ap.add_argument("--case", type=Path, help="instead of the gas: this box case (e.g. cases/bed-25k) for --time s, "
+                                              "heat as its scene says, against the same without heat")
     ap.add_argument("--worker", nargs=4, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker:
         n, t, heat, out = args.worker
         worker(int(n), float(t), heat, Path(out))
         return
+    if args.case:
+        return bench_case(args)
     print(f"dry granular gas (hot-cold-box grown at its packing), {args.time:g} s simulated per run, "
           f"heat A fast path; best of {args.repeat}; one run of this script")
     print(f"{'particles':>9} | {'ranks':>5} | {'plain ms/st':>11} | {'heat ms/st':>10} | {'ratio':>5} | "
@@ -130,6 +170,30 @@ def main() -> None:
                       f"{h['collisions']:>10} | {1e6 * extra:7.1f} | "
                       f"{h['rss_max_mb']:6.0f}/{h['rss_sum_mb']:<7.0f} | {h['in_dem'] / h['wall']:8.0%} | "
                       f"{1 - h['in_dem'] / h['wall']:5.0%} | {first[n] / per_step['A']:8.2f}", flush=True)
+
+
+def bench_case(args) -> None:
+    """A whole case (with its fluid) on each rank count: wall s per simulated s with heat and
+    without, and where the heat-on run's time went."""
+    from pyhost.scene import load_scene
+
+    heat = load_scene(args.case.resolve() / "case.toml").effects.contact_heat
+    print(f"{args.case}: {args.time:g} s simulated per run from its initial state, heat {heat} against none; "
+          f"best of {args.repeat}; one run of this script")
+    print(f"{'ranks':>5} | {'plain wall s/s':>14} | {'heat wall s/s':>13} | {'ratio':>5} | {'collisions':>10} | "
+          f"{'RSS max/sum MB':>14} | {'LIGGGHTS':>8} | {'OpenFOAM':>8} | {'host':>5} | {'speed-up':>8}")
+    with tempfile.TemporaryDirectory() as tmp:
+        first = None
+        for ranks in args.ranks:
+            runs = {h: min((measure(0, ranks, args.time, h, Path(tmp), args.case) for _ in range(args.repeat)),
+                           key=lambda r: r["wall"]) for h in ("none", heat)}
+            p, h = runs["none"], runs[heat]
+            first = first or h["wall"]
+            print(f"{ranks:>5} | {p['wall'] / args.time:14.0f} | {h['wall'] / args.time:13.0f} | "
+                  f"{h['wall'] / p['wall']:5.2f} | {h['collisions']:>10} | "
+                  f"{h['rss_max_mb']:6.0f}/{h['rss_sum_mb']:<7.0f} | {h['in_dem'] / h['wall']:8.0%} | "
+                  f"{h['in_fluid'] / h['wall']:8.0%} | {1 - (h['in_dem'] + h['in_fluid']) / h['wall']:5.0%} | "
+                  f"{first / h['wall']:8.2f}", flush=True)
 
 
 if __name__ == "__main__":
