@@ -106,3 +106,12 @@ def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
     assert restarted == whole
     for name in ("collisions.csv", "history.csv"):
         assert (tmp_path / "cut" / name).read_bytes() == (tmp_path / "whole" / name).read_bytes(), name
+
+
+def test_bad_scene_under_mpirun_exits_2_without_hanging(tmp_path):
+    """Rank 0 refuses the scene before LIGGGHTS starts and releases the other rank: the job
+    ends with rank 0's exit code and its one-line message."""
+    r = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", sys.executable, "-m", "pyhost", "run",
+                        str(tmp_path / "missing")], capture_output=True, text=True, env=ENV, timeout=120)
+    assert r.returncode == 2
+    assert "missing/case.toml: no such scene file" in r.stderr
