@@ -34,7 +34,7 @@ from plugins import convection
 from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
                                temperature_difference)
 from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
-from pyhost import signals
+from pyhost import checkpoint, signals
 from pyhost.engines.dem import Dem
 from pyhost.failures import particles_lost
 from pyhost.engines.liggghts import LiggghtsError
@@ -79,11 +79,12 @@ class Coupling:
     ``initial_T``: function (atoms, mask of new atoms) -> their starting temperature [K]
     (NaN: keep the value LIGGGHTS holds); ``contacts_open``: the contacts present at the start
     (a restart from a settled state) are not collisions: open and enduring from the start.
+    ``resume``: a checkpoint's state (pyhost.checkpoint) to continue from, its logs appended to.
     """
 
     def __init__(self, scene, dem: Dem, out: Path, *, type_material, groups, walls, initial_T, fluid=None,
                  end: float | None = None, progress_every: float = 5.0, keep_all: np.ndarray | None = None,
-                 contacts_open: bool = False):
+                 contacts_open: bool = False, resume: dict | None = None):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
         self.materials = list(scene.materials.values())
@@ -112,23 +113,28 @@ class Coupling:
         self.laws = {}
         if self.heat and dem.info.heat_gran:
             self.check_capacities()
-        atoms = dem.atoms(self.heat)
-        self.track_particles(atoms)
-        self.CT0 = self.totals.pop("energy_in")
-        self.totals["energy_in"] = 0.0
+        if resume is None:
+            self.track_particles(dem.atoms(self.heat))
+            self.CT0 = self.totals.pop("energy_in")
+            self.totals["energy_in"] = 0.0
+        logs = resume["logs"] if resume else {}
         self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS
-                                 + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:]))
+                                 + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:]), logs.get("collisions"))
         self.history = CsvLog(self.out / "history.csv", ("time", "particles", "T_mean", "T_min", "T_max")
                               + tuple(f"T_group{k}" for k in range(len(self.group_names)))
                               + ("sum_mcT", "heat_from_walls", "energy_in", "energy_out", "collisions",
                                  "capped", "clipped") + (FLUID_COLUMNS if fluid is not None else ())
-                              + (GAS_COLUMNS if self.convection else ()))
-        self.frames = VtkSeries(self.out / "vtk", "particles") if scene.output.vtk else None
+                              + (GAS_COLUMNS if self.convection else ()), logs.get("history"))
+        self.frames = VtkSeries(self.out / "vtk", "particles", logs.get("particles")) if scene.output.vtk else None
         self.fluid_frames = VtkSeries(self.out / "vtk", "fluid") if fluid is not None and scene.output.vtk else None
         self.progress = Progress(end or math.inf, progress_every)
         self.every = dict(sample=scene.time.sample_every if self.effects["contact_extraction"] else 0,
                           frame=max(1, round(scene.output.every / dem.dt)),
-                          couple=scene.time.couple_every if fluid is not None else 0)
+                          couple=scene.time.couple_every if fluid is not None else 0,
+                          checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
+        self.ready = resume is not None      # a consistent state to checkpoint (after start())
+        if resume is not None:
+            self.restore(resume)
 
     def update_walls(self, walls) -> None:
         """The LIGGGHTS walls as the host sees them (a script may add walls between runs)."""
@@ -140,6 +146,8 @@ class Coupling:
     def start(self) -> None:
         """The first fluid exchange and the first frame (after construction, so that an
         interrupt from here on finds a coupling to write its summary)."""
+        if self.ready:                    # resumed: the checkpoint's state is all there is
+            return
         if self.contacts_open and self.every["sample"]:
             self.open_present()
         T_gas = self.fluid.temperature() if self.convection else None
@@ -149,20 +157,24 @@ class Coupling:
         # the particles as placed): the gas's initial heat content with that fraction
         self.gas_energy0 = float(np.sum(self.fluid.heat_capacity() * T_gas)) if self.convection else 0.0
         self.write_frame()
+        self.ready = True
 
     def advance(self, n: int) -> None:
-        """n coupled DEM steps: the loop of the module doc."""
+        """n coupled DEM steps: the loop of the module doc. With checkpoints, a signal stops it
+        only at the end of a step, where the state is whole (``signals.deferred``)."""
+        with signals.deferred(bool(self.every["checkpoint"])):
+            self._advance(n)
+
+    def _advance(self, n: int) -> None:
         if self.heat:
             self.resync()
         while n > 0:
             step = self.dem.step - self.t0_step
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
-            if self.keep_all is not None:
-                a = self.dem.atoms(False)
-                self.before = (self.t, a.id.copy(), a.x.copy(), a.v.copy())
+            if self.keep_all is not None and (self.before is None or self.before[4] != self.dem.step):
+                self.note_before(self.dem.atoms(False))
             self.dem.run(chunk)
-            signals.check()
-            if self.keep_all is not None and self.dem.lmp.nlocal < len(self.before[1]):
+            if self.keep_all is not None and self.dem.count() < len(self.before[1]):
                 self.lost()
             n -= chunk
             self.steps += chunk
@@ -173,18 +185,28 @@ class Coupling:
                 atoms = self.dem.atoms(self.heat)
                 self.track_particles(atoms)
                 self.sample_contacts(atoms)
+                if self.keep_all is not None:
+                    self.note_before(atoms)         # spares a gather of all atoms under MPI
             if due["couple"]:
                 self.couple_fluid()
             if due["frame"]:
                 self.write_frame()
+            if due["checkpoint"]:
+                checkpoint.write(self)
             self.progress.update(self.t, f", {self.totals['collisions']} collisions")
+            signals.check()
         if self.heat:
             self.track_particles(self.dem.atoms(True))
+
+    def note_before(self, atoms) -> None:
+        """The particles before the next chunk (time, ids, positions, velocities, step): what
+        a report of lost particles says of them."""
+        self.before = (self.t, atoms.id.copy(), atoms.x.copy(), atoms.v.copy(), self.dem.step)
 
     def lost(self):
         """A box scene lost particles (through an open face, a soft wall, or blown out)."""
         gone = np.setdiff1d(self.before[1], self.dem.atoms(False).id)
-        raise particles_lost(self.scene, gone, self.before, self.dem.step * self.dem.dt, self.keep_all)
+        raise particles_lost(self.scene, gone, self.before[:4], self.dem.step * self.dem.dt, self.keep_all)
 
     def resync(self) -> None:
         """Before each run: heat content that the script's own commands changed since the last
@@ -198,6 +220,29 @@ class Coupling:
             self.totals["energy_set_by_script"] += float(np.sum(C * atoms.T[known])
                                                          - self.CT_by_id[atoms.id[known]].sum())
         self.track_particles(atoms)
+
+    # -- checkpoint (pyhost.checkpoint writes and reads the files) ---------------------------
+    def state(self) -> tuple[dict, dict]:
+        """The host's state at the end of a step: (JSON values, arrays)."""
+        info = np.array([v[:4] + tuple(v[4]) for v in self.open.values()]).reshape(-1, 7)
+        logs = dict(collisions=self.collisions.size, history=self.history.size,
+                    particles=self.frames.frames if self.frames is not None else None)
+        values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, CT0=self.CT0,
+                      gas_energy0=getattr(self, "gas_energy0", 0.0), warned=sorted(self.warned), logs=logs)
+        arrays = dict(open_keys=self.tracker.open_keys, contact_keys=np.array(list(self.open), np.int64),
+                      contact_info=info, CT_by_id=self.CT_by_id, seen=self.seen)
+        return values, arrays
+
+    def restore(self, state: dict) -> None:
+        """Continue from ``state`` (values and arrays of :meth:`state` in one dict)."""
+        for name in ("t0_step", "steps", "t", "CT0", "gas_energy0"):
+            setattr(self, name, state[name])
+        self.totals, self.warned = state["totals"], set(state["warned"])
+        self.tracker.update(state["open_keys"])
+        self.open = {k: (*v[:4].tolist(), v[4:].tolist())
+                     for k, v in zip(state["contact_keys"].tolist(), state["contact_info"])}
+        self.CT_by_id, self.seen = state["CT_by_id"], state["seen"]
+        checkpoint.restore_forces(self.dem, state)
 
     # -- particles ----------------------------------------------------------------------
     def materials_of(self, types) -> np.ndarray:
@@ -539,6 +584,12 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             if n > 0:
                 coupling.advance(n)
     except BaseException as exc:          # keep what was computed: summary of the run so far
+        if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
+                and coupling.every["checkpoint"]:
+            try:
+                checkpoint.write(coupling)
+            except Exception as err:      # the stop goes on: summary, engines closed, exit 128 + n
+                log(f"warning: no checkpoint at the stop ({type(err).__name__}: {err}); the last one stays")
         if coupling is not None:
             coupling.finish(status=f"stopped at t = {coupling.t:g} s by {type(exc).__name__}: {exc}")
         raise

@@ -13,7 +13,8 @@ from pyhost.cli import UserError
 
 # What ``python -m pyhost run`` writes; an overwrite removes these and nothing else.
 RUN_FILES = ("summary.json", "scene.json", "collisions.csv", "history.csv", "vtk", "dem", "fluid",
-             "temperatures.png", "particles.png")
+             "temperatures.png", "particles.png",
+             "checkpoint", ".checkpoint.new", ".checkpoint.old")
 
 
 def prepare_output(out: Path, overwrite: bool = False) -> None:

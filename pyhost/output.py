@@ -8,6 +8,7 @@
 from __future__ import annotations
 
 import csv
+import os
 import sys
 import time
 from pathlib import Path
@@ -17,15 +18,26 @@ import numpy as np
 
 
 class CsvLog:
-    """A CSV file with a fixed header; ``write(rows)`` appends and flushes."""
+    """A CSV file with a fixed header; ``write(rows)`` appends and flushes. ``resume_at``: the
+    size [bytes] of the file at a checkpoint: what came after is cut, and rows follow it."""
 
-    def __init__(self, path: Path, columns: tuple):
+    def __init__(self, path: Path, columns: tuple, resume_at: int | None = None):
         self.path, self.columns = Path(path), columns
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        if resume_at is not None:
+            os.truncate(self.path, resume_at)
+            self._file = open(self.path, "a", newline="")
+            self._csv = csv.writer(self._file)
+            return
         self._file = open(self.path, "w", newline="")
         self._csv = csv.writer(self._file)
         self._csv.writerow(columns)
         self._file.flush()
+
+    @property
+    def size(self) -> int:
+        """Bytes written so far (all flushed)."""
+        return self._file.tell()
 
     def write(self, rows) -> None:
         self._csv.writerows(rows)
@@ -42,12 +54,19 @@ class CsvLog:
 
 
 class VtkSeries:
-    """Points with data, one file per frame, and the .pvd index of the frames so far."""
+    """Points with data, one file per frame, and the .pvd index of the frames so far.
+    ``frames``: those of a checkpoint to continue from; later frame files are removed."""
 
-    def __init__(self, folder: Path, name: str):
+    def __init__(self, folder: Path, name: str, frames: list | None = None):
         self.folder, self.name = Path(folder), name
         self.folder.mkdir(parents=True, exist_ok=True)
-        self.frames: list[tuple[float, str]] = []
+        self.frames: list[tuple[float, str]] = [tuple(f) for f in frames or []]
+        if frames is not None:
+            kept = {f for _, f in self.frames}
+            for old in self.folder.glob(f"{self.name}_*.vtu"):
+                if old.name not in kept:
+                    old.unlink()
+            self._index()
 
     def write(self, t: float, points, **point_data) -> Path:
         file = f"{self.name}_{len(self.frames):05d}.vtu"
@@ -55,13 +74,16 @@ class VtkSeries:
         cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
         meshio.write(self.folder / file, meshio.Mesh(points, cells, point_data=point_data))
         self.frames.append((t, file))
+        self._index()
+        return self.folder / file
+
+    def _index(self) -> None:
         index = self.folder / f"{self.name}.pvd"
         tmp = index.with_suffix(".pvd.tmp")
         tmp.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n<Collection>\n'
                        + "".join(f'<DataSet timestep="{t!r}" file="{f}"/>\n' for t, f in self.frames)
                        + "</Collection>\n</VTKFile>\n")
         tmp.replace(index)
-        return self.folder / file
 
 
 class Progress:

@@ -182,6 +182,9 @@ class Fluid:
     heat_capacity: float = spec(">0", 1005.0, "gas specific heat capacity [J/(kg K)] (with effects.convection)")
     temperature: float = spec(">0", 293.15, "initial gas temperature [K] (with effects.convection)")
     inlet_temperature: float = spec(">=0", 0.0, "gas temperature at the inlet [K]; 0: the initial temperature")
+    ranks: int = spec(">0", 1, "MPI ranks of the fluid solver, started as a job of its own (mpirun -np, "
+                               "after decomposePar; the box mesh is split along x, a user's case needs its own "
+                               "system/decomposeParDict with that many subdomains)")
 
     @property
     def prandtl(self) -> float:
@@ -218,6 +221,9 @@ class Output:
     every: float = spec(">0", 1e-3, "interval between VTK frames [s]")
     vtk: bool = spec(default=True, doc="write VTK time series")
     pictures: bool = spec(default=True, doc="write PNG pictures")
+    checkpoint: float = spec(">=0", 0.0, "simulated time between checkpoints into OUT/checkpoint, also written "
+                             "when a signal stops the run; continue with 'run CASE --restart' [s]; 0: none. "
+                             "Box scenes without fluid only (docs/checkpoint.md)")
 
 
 @dataclass(frozen=True)

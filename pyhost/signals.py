@@ -28,6 +28,7 @@ class Interrupted(BaseException):
 
 
 _received: list[int] = []
+_deferred: list[bool] = [False]
 
 
 def check() -> None:
@@ -39,6 +40,20 @@ def check() -> None:
 
 
 @contextlib.contextmanager
+def deferred(on: bool = True):
+    """Inside, a first signal is only noted and raised at the next :func:`check` (or at the
+    end): the coupling loop stops at the end of a step, where its state is consistent and a
+    checkpoint can be written (pyhost.checkpoint)."""
+    before = _deferred[0]
+    _deferred[0] = on
+    try:
+        yield
+    finally:
+        _deferred[0] = before
+    check()
+
+
+@contextlib.contextmanager
 def stopping():
     """Turn the first of SIGINT, SIGTERM, SIGHUP into :class:`Interrupted`; ignore the rest."""
     first = _received
@@ -46,7 +61,8 @@ def stopping():
     def handler(signum, frame):
         if not first:
             first.append(signum)
-            raise Interrupted(signum)
+            if not _deferred[0]:
+                raise Interrupted(signum)
 
     old = {s: signal.signal(s, handler) for s in SIGNALS}
     try:
@@ -55,3 +71,4 @@ def stopping():
         for s, h in old.items():
             signal.signal(s, h)
         first.clear()
+        _deferred[0] = False

@@ -109,6 +109,20 @@ def check_scene(scene) -> None:
     file, d, tm = scene.path, scene.domain, scene.time
     if scene.fluid is not None and not scene.fluid.alpha_min < 1:
         raise SceneError(f"{file}: fluid.alpha_min: must be in (0, 1), got {scene.fluid.alpha_min!r}")
+    if scene.output.checkpoint and (scene.scripted or scene.effects.fluid):
+        raise SceneError(f"{file}: output.checkpoint: checkpoints are made for box scenes without fluid only; "
+                         f"this scene has {'a LIGGGHTS script' if scene.scripted else 'a fluid'} "
+                         "(docs/checkpoint.md says why)")
+    if scene.fluid is not None and scene.effects.fluid:
+        ranks = scene.fluid.ranks
+        if scene.fluid.case:
+            decompose = scene.folder / scene.fluid.case / "system" / "decomposeParDict"
+            if ranks > 1 and not decompose.is_file():
+                raise SceneError(f"{file}: fluid.ranks = {ranks}: the user's case has no {decompose}, which "
+                                 "decomposePar needs")
+        elif ranks > scene.fluid.cells[0]:
+            raise SceneError(f"{file}: fluid.ranks = {ranks}: the box mesh is split along x into one slab per rank, "
+                             f"and fluid.cells has only {scene.fluid.cells[0]} cells in x")
     if scene.scripted:          # the script places the particles and sets the box and the step
         return
     for k, w in enumerate(scene.walls):

@@ -17,7 +17,7 @@ sudo=""
 [ "$(id -u)" = 0 ] || sudo=sudo
 
 packages=(liggghts libliggghts-dev liggghts-doc openfoam libopenfoam openfoam-examples
-          libopenmpi-dev openmpi-bin g++ make flex bzip2)
+          libopenmpi-dev openmpi-bin python3-mpi4py g++ make flex bzip2)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -105,4 +105,8 @@ if changed openfoam plugins/openfoam "$solver"; then
     )
     done_build openfoam
 fi
+# mpi4py for the host under mpirun: Debian's, built against the same OpenMPI as LIGGGHTS
+# (a PyPI wheel may bring another MPI). Only that package is linked into .venv.
+site=$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+[ -e "$site/mpi4py" ] || ln -s /usr/lib/python3/dist-packages/mpi4py "$site/mpi4py"
 echo "setup_engines: ready (solver $solver, helper $helper)"

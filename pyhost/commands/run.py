@@ -20,6 +20,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", type=Path, default=None, help="output folder (default CASE/output)")
     p.add_argument("--test", action="store_true", help="smoke run: only time.test_end (default end/10)")
     p.add_argument("--overwrite", action="store_true", help="replace the run already in the output folder")
+    p.add_argument("--restart", action="store_true", help="continue the run in the output folder from its "
+                   "checkpoint (output.checkpoint), appending to its output")
 
 
 def resolved(scene) -> dict:
@@ -49,7 +51,7 @@ def start_fluid(scene, folder: Path):
         if energy:                      # the gas's properties are the scene's, given once
             FoamFile(folder / "constant" / "transportProperties").update({"Cp": f.heat_capacity,
                                                                            "kappa": f.conductivity})
-        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy).start()
+        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
@@ -61,26 +63,32 @@ def start_fluid(scene, folder: Path):
                     nu=f.viscosity / f.density, gravity=scene.domain.gravity,
                     dt=scene.time.couple_every * scene.time.dem_step,
                     T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
-                    T_inlet=f.inlet_temperature or f.temperature, T_walls=sides)
-    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy).start()
+                    T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
+    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
 
 
-def box_world(scene, out: Path, start=None):
+def box_world(scene, out: Path, start=None, restart: Path | None = None):
     """The generated DEM of a box scene: its script (run for time.end) and how the host sees
     its particles: one atom type per material, groups = the [[particles]] tables, walls
     ``wall<k>`` = the scene's [[walls]]. ``start``: the particles (``pyhost.dem_input.Particles``,
     e.g. a settled bed) to start from instead of the scene's placement; the contacts present
-    then are not collisions of this run."""
+    then are not collisions of this run. ``restart``: LIGGGHTS' restart file of a checkpoint
+    to read instead of the particles (the same commands re-issued, with the same ids)."""
     from pyhost.dem_input import input_lines, place_particles, write_data
     from pyhost.loop import HostWall
 
     folder = out / "dem"
     folder.mkdir(parents=True, exist_ok=True)
     particles = place_particles(scene) if start is None else start
-    data = write_data(folder / "particles.data", scene, particles)
-    script = folder / "in.dem"
     steps = round(scene.time.end / scene.time.dem_step)
-    script.write_text("\n".join(["atom_modify sort 0 0"] + input_lines(scene, data) + [f"run {steps}"]) + "\n")
+    if restart is None:
+        data = write_data(folder / "particles.data", scene, particles)
+        script, lines, run = folder / "in.dem", input_lines(scene, data), f"run {steps}"
+    else:
+        script, run = folder / "in.restart", f"run {steps} upto"
+        lines = [f"read_restart {restart}" if line.startswith("read_data ") else line
+                 for line in input_lines(scene, Path("-"))]
+    script.write_text("\n".join(["atom_modify sort 0 0"] + lines + [run]) + "\n")
     index = {name: k for k, name in enumerate(scene.materials)}
     T_by_id = np.r_[np.nan, particles.temperature]
     group_by_id = np.r_[-1, particles.group]
@@ -140,11 +148,13 @@ def user_script(scene):
 
 
 def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None, wrap_fluid=None,
-             start=None) -> dict:
+             start=None, resume: dict | None = None, link=None) -> dict:
     """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
     world, with the fluid if the scene has one. ``wrap(dem)`` and ``wrap_fluid(fluid)`` may
     stand in front of the engines (tests inject faults, benchmarks record with them);
-    ``start``: the particles a box scene starts from (see ``box_world``). Returns the summary."""
+    ``start``: the particles a box scene starts from (see ``box_world``); ``resume``: the state of
+    a checkpoint to continue from (``pyhost.checkpoint.load``); ``link``: the other MPI ranks'
+    LIGGGHTS (``pyhost.engines.ranks``), None when serial. Returns the summary."""
     from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
     from pyhost.loop import run_scene
@@ -160,21 +170,22 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         if scene.time.dem_step > t_c / 20:
             print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
                   f"({t_c:.3g} s) with fewer than 20 steps")
-        script, particles = box_world(scene, out, start)
+        script, particles = box_world(scene, out, start, resume and resume["restart"])
+        particles["resume"] = resume
         variables = {}
     commands = read_script(script, scene.folder)
     fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None
     cwd = os.getcwd()
     try:
         os.chdir(scene.folder)          # the script's relative paths, as with 'liggghts -in' there
-        dem = Dem(out / "dem", variables=variables)
+        dem = Dem(out / "dem", variables=variables, link=link)
         try:
             return run_scene(scene, wrap(dem) if wrap else dem, commands, out, max_time=max_time,
                              fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
                              end=None if scene.scripted else scene.time.end, progress_every=progress_every,
                              **particles)
         finally:
-            dem.lmp.close()
+            dem.close()
     finally:
         os.chdir(cwd)
         if fluid is not None:
@@ -182,20 +193,46 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
 
 
 def run(args) -> int:
+    """Serial, or rank 0 under mpirun (the other ranks follow: ``pyhost.engines.ranks``)."""
+    from pyhost.engines.ranks import Follower, Link, world
+
+    comm = world()
+    if comm is not None and comm.Get_rank() != 0:
+        return Follower(comm).serve()
+    link = Link(comm) if comm is not None else None
+    try:
+        return run_case(args, link)
+    finally:
+        if link is not None:
+            link.close()
+
+
+def run_case(args, link) -> int:
     from pyhost.outdir import prepare_output, write_atomic
     from pyhost.scene import load_scene
 
-    scene = load_scene(args.case / "case.toml")
+    scene = load_scene((args.case / "case.toml").absolute())    # the run changes directory
     if args.test and not scene.scripted:
         end = scene.time.test_end or scene.time.end / 10
         scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=end))
     effects = scene.effects_summary()
     out = (args.out or args.case / "output").resolve()
-    prepare_output(out, args.overwrite)
+    resume = None
+    if args.restart:
+        from pyhost.checkpoint import load
+        from pyhost.cli import UserError
+
+        if args.overwrite:
+            raise UserError("--restart continues the run in the output folder, --overwrite replaces it: give one")
+        resume = load(out, scene)
+    else:
+        prepare_output(out, args.overwrite)
     print("scene:", json.dumps(resolved(scene), indent=1, default=str))
     print("active effects:", ", ".join(k for k, on in effects.items() if on) or "none (plain DEM)")
     write_atomic(out / "scene.json", json.dumps(resolved(scene), indent=1, default=str))
-    summary = simulate(scene, out, test=args.test)
+    if link is not None:
+        print(f"MPI: LIGGGHTS on {link.size} ranks; the host on rank 0")
+    summary = simulate(scene, out, test=args.test, resume=resume, link=link)
     print("summary:", json.dumps(summary, indent=1))
     if scene.output.pictures:        # own process: see pyhost/commands/pictures.py
         drawn = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(out)])

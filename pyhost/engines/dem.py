@@ -9,10 +9,17 @@ contact, from LIGGGHTS' own ``compute pair/gran/local`` and ``wall/gran/local``,
 geometry of primitive walls, which LIGGGHTS does not list). Temperatures live in LIGGGHTS'
 per-atom ``Temp`` (the property ``fix heat/gran`` uses), so a script's dumps, restarts and
 fixes see them. What the host adds to a script it prints once, before the first run.
+
+Under mpirun (``link``, :mod:`pyhost.engines.ranks`) LIGGGHTS runs on every rank and this
+class on rank 0 orders the other ranks' part of each collective call. ``atoms()`` is then a
+gathered copy of all ranks' atoms; what the loop writes into its ``T`` and ``v`` (and
+``add_velocity``) goes back to the owning ranks at the next call into LIGGGHTS. Serially
+the arrays are LIGGGHTS' own memory and nothing needs to go back.
 """
 from __future__ import annotations
 
 import ctypes
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,6 +27,7 @@ import numpy as np
 
 from pyhost.collisions import WALL_BASE
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
+from pyhost.engines.ranks import local_atoms, local_values, put_by_id, write_local
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 
 FLUID_FIX = "collheat_fluid"
@@ -76,18 +84,40 @@ class Dem:
     """LIGGGHTS running a scene's script. ``walls``: the host's walls in order, each
     (fix id, material name or None for adiabatic LIGGGHTS walls the scene does not name)."""
 
-    def __init__(self, workdir: Path, *, variables: dict | None = None, log=print):
-        self.lmp = Liggghts(Path(workdir).resolve(), variables=variables)
+    def __init__(self, workdir: Path, *, variables: dict | None = None, log=print, link=None):
+        self.link = link
+        if link is not None:
+            link.order("open", os.getcwd(), str(Path(workdir).resolve()), variables)
+        self.lmp = Liggghts(Path(workdir).resolve(), variables=variables, comm=link and link.comm)
         self.info = ScriptInfo()
         self.log = log
         self.pair_cols = self.wall_cols = None
         self._warned_mesh = False
+        self._pending = None      # under MPI: the last gathered atoms, their T and v as gathered
+        self._counts = None       # under MPI: atoms per rank in the last gather
+
+    def _order(self, name: str, *args) -> None:
+        """Under MPI: what the host changed goes back to the ranks, then the followers make
+        the same call as rank 0 is about to."""
+        if self.link is not None:
+            self._commit()
+            self.link.order(name, *args)
+
+    def _raw(self, line: str) -> None:
+        self._order("command", line)
+        self.lmp.command(line)
+        self._pending = None            # a command may move, add or delete atoms
+
+    def close(self) -> None:
+        if self.link is not None:
+            self.link.close()
+        self.lmp.close()
 
     # -- the script -----------------------------------------------------------------
     def command(self, cmd: Command) -> None:
         """Run one script command; a refusal names the script's file and line."""
         try:
-            self.lmp.command(cmd.text)
+            self._raw(cmd.text)
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()}: {exc}") from None
         self.info.learn(cmd)
@@ -97,7 +127,8 @@ class Dem:
         try:
             n = int(steps)
         except ValueError:
-            self.lmp.command(f"variable collheat_steps equal {steps}")
+            self._raw(f"variable collheat_steps equal {steps}")
+            self._order("variable", "collheat_steps")
             n = int(round(self.lmp.variable("collheat_steps")))
         return n - self.lmp.step if upto else n
 
@@ -126,14 +157,25 @@ class Dem:
                 if missing:
                     raise ScriptError(f"the script's compute {found[0]} lacks the keyword(s) {' '.join(missing)} "
                                       "the host needs: add them (LIGGGHTS allows one such compute)")
-        self.lmp.run(0)
+        self.run(0)
         if fluid_force:         # the set-up added fix external's array while it was uninitialised
-            self.lmp.external_force(FLUID_FIX)[:] = 0.0     # memory: zero it and set up again
-            self.lmp.command("run 0")
+            self.set_force(np.zeros((self.count() if self.link else self.lmp.nlocal, 3)))  # memory: zero it
+            self._raw("run 0")                                                              # and set up again
         return added
 
     def run(self, steps: int) -> None:
+        self._order("run", int(steps))
         self.lmp.run(int(steps))
+        self._pending = None            # the gathered atoms are out of date
+
+    def count(self) -> int:
+        """Number of particles on all ranks now."""
+        if self.link is None:
+            return self.lmp.nlocal
+        self._order("count")
+        counts = self.link.gather(self.lmp.nlocal)
+        self._counts = np.array(counts)
+        return int(sum(counts))
 
     @property
     def dt(self) -> float:
@@ -151,16 +193,73 @@ class Dem:
     # -- particles --------------------------------------------------------------------
     def atoms(self, temperature: bool = True) -> Atoms:
         lmp = self.lmp
-        T = lmp.temperature() if temperature and lmp.nlocal else (np.zeros(0) if temperature else None)
-        return Atoms(lmp.atom("id").astype(np.int64), lmp.atom("x"), lmp.atom("v"), lmp.atom("radius"),
-                     lmp.atom("rmass"), lmp.atom("type"), T)
+        if self.link is None:
+            T = lmp.temperature() if temperature and lmp.nlocal else (np.zeros(0) if temperature else None)
+            return Atoms(lmp.atom("id").astype(np.int64), lmp.atom("x"), lmp.atom("v"), lmp.atom("radius"),
+                         lmp.atom("rmass"), lmp.atom("type"), T)
+        self._order("atoms", temperature)
+        parts = self.link.gather(local_atoms(lmp, temperature))
+        self._counts = np.array([len(p[0]) for p in parts])
+        cols = [np.concatenate([p[k] for p in parts]) for k in range(len(parts[0]))]
+        atoms = Atoms(cols[0].astype(np.int64), *cols[1:6], cols[6] if temperature else None)
+        self._pending = (atoms, None if atoms.T is None else atoms.T.copy(), atoms.v.copy())
+        return atoms
+
+    def _commit(self) -> None:
+        """Under MPI: the temperatures and velocities the host changed in the last gathered
+        atoms go to the ranks that own them (nothing is sent when nothing changed). They stay
+        valid until the next run or command: later changes go at the next call."""
+        if self._pending is None:
+            return
+        atoms, T0, v0 = self._pending
+        T = None if T0 is None or np.array_equal(atoms.T, T0) else atoms.T
+        v = None if np.array_equal(atoms.v, v0) else atoms.v
+        if T is not None or v is not None:
+            self._pending = (atoms, None if T0 is None else atoms.T.copy(), atoms.v.copy())
+            self._write(T=T, v=v)
+
+    def _write(self, **arrays) -> None:
+        """Each rank's slice (the local order of the last gather) of per-atom arrays."""
+        cut = np.cumsum(self._counts)[:-1]
+        names = ("T", "v", "force")
+        pieces = [np.split(arrays[k], cut) if arrays.get(k) is not None else [None] * len(self._counts)
+                  for k in names]
+        self.link.order("write", FLUID_FIX)
+        write_local(self.lmp, *self.link.scatter(list(zip(*pieces))), force_fix=FLUID_FIX)
+
+    def per_atom(self, names) -> tuple:
+        """Copies of per-atom arrays (``Liggghts.atom`` names, e.g. id, f, torque) of all atoms,
+        in the order of ``atoms()``."""
+        if self.link is None:
+            return local_values(self.lmp, names)
+        self._order("per_atom", tuple(names))
+        parts = self.link.gather(local_values(self.lmp, names))
+        return tuple(np.concatenate([p[k] for p in parts]) for k in range(len(names)))
+
+    def put_per_atom(self, ids, **arrays) -> None:
+        """Per-atom arrays given for all atoms by id (e.g. f=..., torque=...) into LIGGGHTS."""
+        self._order("put", ids, arrays)
+        put_by_id(self.lmp, ids, arrays)
+
+    def engine_command(self, line: str) -> None:
+        """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""
+        self._raw(line)
 
     def add_velocity(self, local_index, dv) -> None:
-        np.add.at(self.lmp.atom("v"), np.asarray(local_index), dv)
+        """Add dv [m/s] to the velocity of these atoms (indices into the last ``atoms()``)."""
+        v = self.lmp.atom("v") if self.link is None else self._pending[0].v
+        np.add.at(v, np.asarray(local_index), dv)
 
     def set_force(self, force) -> None:
-        """Force [N] on each local atom, applied every step until changed."""
-        self.lmp.external_force(FLUID_FIX)[:] = force
+        """Force [N] on each atom (the order of the last ``atoms()``), applied every step
+        until changed."""
+        if self.link is None:
+            self.lmp.external_force(FLUID_FIX)[:] = force
+            return
+        self._commit()
+        if len(force) != self._counts.sum():
+            raise ValueError(f"{len(force)} forces for {self._counts.sum()} particles")
+        self._write(force=np.asarray(force, float))
 
     # -- the DEM's own values -----------------------------------------------------------
     def type_values(self, prop: str, types) -> np.ndarray:
@@ -183,7 +282,7 @@ class Dem:
         """Every contact now (see :class:`Contacts`). ``wall_index``: host wall index of each
         (wall/gran fix id, mesh index in the fix); a particle touching several triangles of one
         mesh is one contact (the deepest)."""
-        parts = [self._pair_contacts()]
+        parts = [self._pair_contacts(atoms)]
         for fix, wall in self.info.walls.items():
             if wall.primitive is not None:
                 parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix, 0]))
@@ -196,21 +295,24 @@ class Dem:
         elif mesh_fixes:
             fix = mesh_fixes[-1]
             codes = [WALL_BASE + wall_index[fix, k] for k in range(len(self.info.walls[fix].meshes))]
-            parts.append(self._mesh_contacts(np.array(codes, np.int64)))
+            parts.append(self._mesh_contacts(atoms, np.array(codes, np.int64)))
         return _concat(parts)
 
     def _local(self, which: str):
         compute_id, keywords = getattr(self.info, which)
-        a = self.lmp.local_array(compute_id)
+        if self.link is None:
+            a = self.lmp.local_array(compute_id)
+        else:
+            self._order("local", compute_id)
+            a = np.concatenate(self.link.gather(self.lmp.local_array(compute_id)))
         cols_attr = "pair_cols" if which == "pair_compute" else "wall_cols"
         if getattr(self, cols_attr) is None:
             setattr(self, cols_attr, local_columns(keywords, a.shape[1]))
         return a, getattr(self, cols_attr)
 
-    def _pair_contacts(self) -> Contacts:
+    def _pair_contacts(self, atoms: Atoms) -> Contacts:
         a, c = self._local("pair_compute")
         xi, xj = a[:, c["pos"]][:, :3], a[:, c["pos"]][:, 3:]
-        vi, vj = a[:, c["vel"]][:, :3], a[:, c["vel"]][:, 3:]
         d = xi - xj
         lo, hi, periodic = self.box()
         length = hi - lo
@@ -218,16 +320,24 @@ class Dem:
         dist = np.linalg.norm(d, axis=1)
         n = d / np.where(dist > 0, dist, 1.0)[:, None]
         ids = a[:, c["id"]]
+        # the owners' velocities: a ghost partner (another rank's atom, or a periodic image)
+        # carries the half-step velocity LIGGGHTS communicated before its final integration
+        at = atoms.index(ids[:, :2].astype(np.int64))
+        vi, vj = atoms.v[at[:, 0]], atoms.v[at[:, 1]]
         if "delta" in c:
             delta = a[:, c["delta"]][:, 0]
         else:
-            r = self.lmp.radii_of(ids[:, :2].astype(np.int64))
+            r = atoms.radius[at]
             delta = r.sum(axis=1) - dist
         flux = a[:, c["heatFlux"]][:, 0] if "heatFlux" in c else np.zeros(len(a))
-        return Contacts(ids[:, 0].astype(np.int64), ids[:, 1].astype(np.int64), delta, n,
-                        -np.einsum("ij,ij->i", vi - vj, n), flux)
+        # i the smaller id: LIGGGHTS lists a pair either way round (by its local order, or on
+        # the rank owning the larger id), and the collision rows should not depend on that
+        i, j = ids[:, 0].astype(np.int64), ids[:, 1].astype(np.int64)
+        s = np.where(i < j, 1.0, -1.0)
+        return Contacts(np.minimum(i, j), np.maximum(i, j), delta, n * s[:, None],
+                        -np.einsum("ij,ij->i", vi - vj, n), flux * s)
 
-    def _mesh_contacts(self, codes: np.ndarray) -> Contacts:
+    def _mesh_contacts(self, atoms: Atoms, codes: np.ndarray) -> Contacts:
         a, c = self._local("wall_compute")
         cp, xp = a[:, c["pos"]][:, :3], a[:, c["pos"]][:, 3:]
         vw, vp = a[:, c["vel"]][:, :3], a[:, c["vel"]][:, 3:]
@@ -236,7 +346,7 @@ class Dem:
         d = xp - cp
         dist = np.linalg.norm(d, axis=1)
         n = d / np.where(dist > 0, dist, 1.0)[:, None]
-        delta = a[:, c["delta"]][:, 0] if "delta" in c else self.lmp.radii_of(pid) - dist
+        delta = a[:, c["delta"]][:, 0] if "delta" in c else atoms.radius[atoms.index(pid)] - dist
         order = np.lexsort((-delta, wall, pid))        # deepest triangle of each particle and mesh first
         new = np.r_[True, (pid[order][1:] != pid[order][:-1]) | (wall[order][1:] != wall[order][:-1])]
         first = order[new] if len(pid) else order

@@ -38,6 +38,7 @@ _vp, _cp, _int = _c.c_void_p, _c.c_char_p, _c.c_int
 _DECLARATIONS = {
     # name: (restype, argtypes) -- the 2013 LAMMPS C API that LIGGGHTS 3.8 exports
     "lammps_open_no_mpi": (None, [_int, _c.POINTER(_cp), _c.POINTER(_vp)]),
+    "lammps_open": (None, [_int, _c.POINTER(_cp), _vp, _c.POINTER(_vp)]),
     "lammps_close": (None, [_vp]),
     "lammps_file": (None, [_vp, _cp]),
     "lammps_command": (_cp, [_vp, _cp]),
@@ -60,7 +61,7 @@ _HELPER_DECLARATIONS = {
 # Per-atom arrays: name -> (ctype, columns; 0 for a vector).
 _ATOM = {
     "x": (_c.c_double, 3), "v": (_c.c_double, 3), "f": (_c.c_double, 3),
-    "omega": (_c.c_double, 3), "radius": (_c.c_double, 0), "rmass": (_c.c_double, 0),
+    "omega": (_c.c_double, 3), "torque": (_c.c_double, 3), "radius": (_c.c_double, 0), "rmass": (_c.c_double, 0),
     "id": (_c.c_int, 0), "type": (_c.c_int, 0),
 }
 
@@ -124,21 +125,26 @@ def granular_box(lo, hi, *, youngs: float, poisson: float, restitution: float,
 
 
 class Liggghts:
-    """One LIGGGHTS instance in this process (serial, no MPI communicator of ours).
+    """One LIGGGHTS instance in this process: serial, or one rank of a LIGGGHTS that
+    decomposes its domain over the ranks of ``comm`` (an mpi4py communicator; every rank
+    must then make the same collective calls: commands, runs, variables).
 
-    ``workdir``: where LIGGGHTS writes its screen log (``log.liggghts``); a temporary
-    directory if None. ``check``: try commands in a forked copy first (see the module doc).
+    ``workdir``: where LIGGGHTS writes its screen log (``log.liggghts``; rank 0's only); a
+    temporary directory if None. ``check``: try commands in a forked copy first (see the
+    module doc; never on several ranks, where a forked copy cannot take part in MPI: there a
+    LIGGGHTS error ends the job through MPI_Abort, with its message on stderr).
     """
 
     def __init__(self, workdir: str | os.PathLike | None = None, *, check: bool = True,
-                 variables: dict | None = None):
+                 variables: dict | None = None, comm=None):
         if not HELPER.is_file():
             raise LiggghtsError(f"{HELPER} is missing: run tools/setup.sh --engines")
         self._tmp = None if workdir else tempfile.TemporaryDirectory(prefix="liggghts-")
         self.workdir = Path(workdir or self._tmp.name)
         self.workdir.mkdir(parents=True, exist_ok=True)
         self.log = self.workdir / "log.liggghts"
-        self.check = check
+        self.comm = comm if comm is not None and comm.Get_size() > 1 else None
+        self.check = check and self.comm is None
         # The helper first: its MPI_Abort must come before OpenMPI's (see plugins/liggghts).
         self.helper = ctypes.CDLL(str(HELPER), mode=ctypes.RTLD_GLOBAL)
         self.lib = ctypes.CDLL(LIB, mode=ctypes.RTLD_GLOBAL)
@@ -149,6 +155,12 @@ class Liggghts:
             args += [b"-var", str(name).encode(), str(value).encode()]
         argv = (_cp * len(args))(*args)
         self.ptr = _vp()
+        self._changed = True  # a command since the last run: try the next run first
+        if self.comm is not None:
+            from mpi4py import MPI
+            self.lib.lammps_open(len(args), argv, _vp(MPI._handleof(self.comm)), ctypes.byref(self.ptr))
+            self._watch()
+            return
         # A forked copy must be able to call MPI_Finalize without a server of the parent's
         # MPI: a singleton MPI without one. Set only while MPI starts (mpirun's children
         # must not inherit it).
@@ -161,12 +173,14 @@ class Liggghts:
                 del os.environ[_ISOLATED]
             else:
                 os.environ[_ISOLATED] = saved
+        self._watch()
+
+    def _watch(self) -> None:
         self.helper.collheat_watch_exit(self.ptr, str(self.log).encode())
         global _disarm_registered
         if not _disarm_registered:  # Python's own exit runs this first: the helper stays quiet
             atexit.register(self.helper.collheat_watch_exit, None, b"")
             _disarm_registered = True
-        self._changed = True  # a command since the last run: try the next run first
 
     # -- commands ---------------------------------------------------------------------
     def command(self, line: str) -> None:

@@ -56,6 +56,8 @@ def _exchange(method):
 def foam_env() -> dict:
     """Environment for Debian's OpenFOAM v1912 binaries and OpenMPI as root."""
     env = dict(os.environ)
+    if "OMPI_COMM_WORLD_SIZE" in env:   # a host started by mpirun: the solver (or its own mpirun)
+        env = {k: v for k, v in env.items() if not k.startswith(("OMPI_", "PMIX_", "PMI_", "OPAL_"))}  # is a job of its own
     env.setdefault("WM_PROJECT_DIR", "/usr/share/openfoam")
     env.setdefault("USER", "root")
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
@@ -193,6 +195,7 @@ class FluidSolver:
                 for rank in range(self.nprocs):
                     self._read(rank, np.float64, 1)
                 self.proc.wait(timeout=self.timeout)
+                self._reconstruct()
         finally:
             for fds in self._fds:
                 for fd in fds:
@@ -201,6 +204,13 @@ class FluidSolver:
             self._kill()
             self.proc = None
             shutil.rmtree(self.case / ".link", ignore_errors=True)
+
+    def _reconstruct(self) -> None:
+        """A decomposed run's written times (``write()``) as whole fields in the case, as a
+        serial run leaves them (reconstructPar, for the times not reconstructed yet)."""
+        if self.nprocs > 1 and any(p.name != "0" and p.name[0].isdigit()
+                                   for p in (self.case / "processor0").iterdir()):
+            run_utility(self.case, "reconstructPar", "-newTimes")
 
     def _kill(self) -> None:
         """SIGKILL the solver's session (also stopped processes and mpirun's ranks) and reap it."""

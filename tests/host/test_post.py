@@ -210,6 +210,20 @@ def test_offline_agrees_with_the_online_run(pour_dumps, tmp_path):
     wall = np.array([on[k]["wall"] != "0" for k in sorted(on, key=str)])
     print(f"v0: max relative difference {np.max(np.abs(v_off / v_on - 1)):.2g}; wall heat "
           f"{-Q_off[wall].sum():.6g} J offline, {-Q_on[wall].sum():.6g} J online")
-    assert np.allclose(v_off, v_on, rtol=5e-4)             # dumps keep 6 digits of x, v and the overlap
+    # A pair across a periodic side is listed with the image's (ghost's) velocity, which LIGGGHTS
+    # communicated half a step before the step's end; the host takes the owners' velocities,
+    # post has only the dump's. Those pairs (periodic flag, column 15) may differ by half a step
+    # of acceleration; the others agree to the 6 digits the dumps keep.
+    periodic = set()
+    for dump in (pour_dumps / "post").glob("pair.*"):
+        lines = dump.read_text().splitlines()
+        for line in lines[lines.index(next(ln for ln in lines if ln.startswith("ITEM: ENTRIES"))) + 1:]:
+            c = line.split()
+            if float(c[14]) == 1.0:
+                periodic.add(frozenset((str(int(float(c[12]))), str(int(float(c[13]))), "0")))
+    image = np.array([k[1] in periodic for k in sorted(on, key=str)])
+    assert 0 < image.sum() < 0.2 * len(image)
+    assert np.allclose(v_off[~image], v_on[~image], rtol=5e-4)    # dumps keep 6 digits of x, v and the overlap
+    assert np.allclose(v_off[image], v_on[image], rtol=0.05)
     assert -Q_off[wall].sum() == pytest.approx(run["heat_from_walls"], rel=1e-4)
     assert np.abs(Q_off[~wall]).sum() == pytest.approx(np.abs(Q_on[~wall]).sum(), rel=1e-3)

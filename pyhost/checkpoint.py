@@ -1,0 +1,171 @@
+"""Checkpoints of a run and the restart from one (docs/checkpoint.md).
+
+Every ``output.checkpoint`` seconds of simulated time, and when a signal stops the run, the
+coupling loop calls :func:`write` at the end of a step. It writes OUT/.checkpoint.new/:
+
+- ``dem.restart``: LIGGGHTS' ``write_restart`` (atoms, the per-atom ``Temp`` of ``fix
+  property/atom Temp ... restart yes``, the tangential contact history of ``fix
+  contacthistory`` and of the primitive walls);
+- ``host.npz``: the host's arrays (open contacts with their start, t_coll, e, v0 and normal;
+  m c T by id; the ids seen) and each atom's force and torque of the last step;
+- ``host.json``: the host's values (totals, CT0, steps, warnings given, the byte size of
+  collisions.csv and history.csv and the VTK frames at this step);
+- ``manifest.json`` last: the scene file's SHA-256, the code version (SHA-256 of pyhost/ and
+  plugins/ sources), step, time, the run's end, and the SHA-256 of each file above;
+
+then renames it to OUT/checkpoint (the previous one is moved aside first and removed after),
+so a failed or interrupted write never destroys the last good checkpoint.
+
+Why the forces. ``write_restart`` re-initialises LIGGGHTS (wraps periodic positions, rebuilds
+ghost atoms), and a restart's first run sets up again, which recomputes the forces with the
+full-step velocities where the step computed them with half-step ones (velocity Verlet; the
+Hertz damping depends on velocity). Both the continuing run (after writing) and the
+restarted run (after reading) set up and then put the step's own forces and torques back;
+the contact history is not advanced by a set-up (LIGGGHTS' ``shearupdate`` is off then). So a
+restart continues exactly as the run that wrote the checkpoint.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import time
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from pyhost.cli import UserError
+from pyhost.outdir import write_atomic
+
+FOLDER, RESTART, FORMAT = "checkpoint", "dem.restart", 1
+FILES = (RESTART, "host.npz", "host.json")
+ROOT = Path(__file__).resolve().parents[1]
+SOURCES = ("*.py", "*.C", "*.H", "*.cpp", "*.h")
+
+
+@lru_cache(maxsize=1)
+def code_version() -> str:
+    """SHA-256 of the host's and the plugins' sources (paths and contents)."""
+    h = hashlib.sha256()
+    files = sorted({p for d in ("pyhost", "plugins") for pat in SOURCES for p in (ROOT / d).rglob(pat)
+                    if "__pycache__" not in p.parts})
+    for p in files:
+        h.update(str(p.relative_to(ROOT)).encode() + b"\0" + p.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def write(coupling) -> Path:
+    """A checkpoint of ``coupling`` (a ``pyhost.loop.Coupling`` at the end of a step) into
+    OUT/checkpoint; returns its folder."""
+    start = time.perf_counter()
+    out, dem, scene = coupling.out, coupling.dem, coupling.scene
+    final, new, old = out / FOLDER, out / ".checkpoint.new", out / ".checkpoint.old"
+    shutil.rmtree(new, ignore_errors=True)
+    new.mkdir()
+    ids, f, torque = dem.per_atom(("id", "f", "torque"))
+    ids = ids.astype(np.int64)
+    dem.engine_command(f"write_restart {new / RESTART}")
+    dem.run(0)                                   # set up again, then the step's own forces back
+    _put_forces(dem, ids, f, torque)
+    values, arrays = coupling.state()
+    np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **arrays)
+    write_atomic(new / "host.json", json.dumps(values, indent=1))
+    manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
+                    code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
+                    files={name: _sha256(new / name) for name in FILES})
+    write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
+    shutil.rmtree(old, ignore_errors=True)
+    if final.exists():
+        final.rename(old)
+    new.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+    size = sum(p.stat().st_size for p in final.iterdir())
+    print(f"checkpoint at t = {coupling.t:.6g} s (step {dem.step}): {final}, {size / 1e6:.3g} MB, "
+          f"{time.perf_counter() - start:.2f} s", flush=True)
+    return final
+
+
+def _put_forces(dem, ids, f, torque) -> None:
+    """Forces [N] and torques [N m] of the atoms with these ids into LIGGGHTS (on every rank)."""
+    if dem.count() != len(ids):
+        raise UserError("checkpoint: the restart file's atoms are not those of host.npz (corrupt checkpoint)")
+    try:
+        dem.put_per_atom(ids, f=f, torque=torque)
+    except ValueError as exc:
+        raise UserError(f"checkpoint: the restart file's atoms are not those of host.npz (corrupt checkpoint): "
+                        f"{exc}") from None
+
+
+def restore_forces(dem, state: dict) -> None:
+    """After the restarted DEM's set-up: the forces and torques of the checkpoint's step."""
+    _put_forces(dem, state["ids"], state["f"], state["torque"])
+
+
+def refuse(scene) -> str | None:
+    """Why this scene cannot be restarted (None: it can)."""
+    if scene.scripted:
+        return ("a scene with its own LIGGGHTS script ([dem] script) cannot be restarted yet: the host would have "
+                "to rewrite the user's script (read_restart in place of its box, regions and insertion, with "
+                "every fix re-issued under its id); see docs/checkpoint.md")
+    if scene.effects.fluid:
+        return ("a scene with a fluid cannot be restarted yet: the fluid's time directory and the fluid force of "
+                "the last coupling are not part of a checkpoint; see docs/checkpoint.md")
+    return None
+
+
+def load(out: Path, scene) -> dict:
+    """The checkpoint in OUT/checkpoint checked against this scene and this code: its host
+    state (values and arrays in one dict) and ``restart``, the path of LIGGGHTS' restart
+    file. UserError (exit 2) saying why if there is none, it belongs to another case or
+    another code version, or it is damaged; nothing is written."""
+    why = refuse(scene)
+    if why:
+        raise UserError(f"--restart: {why}")
+    folder = Path(out) / FOLDER
+    if not folder.is_dir() and (Path(out) / ".checkpoint.old").is_dir():
+        folder = Path(out) / ".checkpoint.old"    # a write was cut between its two renames
+    if not folder.is_dir():
+        raise UserError(f"--restart: no checkpoint in {Path(out) / FOLDER} (give the scene output.checkpoint > 0, "
+                        "or stop a run with a signal once it has one)")
+    try:
+        manifest = json.loads((folder / "manifest.json").read_text())
+        if not isinstance(manifest, dict) or not isinstance(manifest.get("files"), dict):
+            raise ValueError("not a manifest")
+    except (OSError, ValueError) as exc:
+        raise UserError(f"--restart: corrupt checkpoint: {folder / 'manifest.json'}: {exc}") from None
+    if manifest.get("format") != FORMAT:
+        raise UserError(f"--restart: {folder}: checkpoint format {manifest.get('format')!r}, this code reads {FORMAT}")
+    if manifest.get("scene_sha256") != _sha256(Path(scene.path)):
+        raise UserError(f"--restart: {folder} is the checkpoint of another case or of another version of "
+                        f"{scene.path} (written for {manifest.get('scene')}; the scene file's SHA-256 differs)")
+    if manifest.get("code_version") != code_version():
+        raise UserError(f"--restart: {folder} was written by another code version ({str(manifest.get('code_version'))[:12]}"
+                        f", this is {code_version()[:12]}: SHA-256 of pyhost/ and plugins/); restart it with that code")
+    if manifest.get("end") != scene.time.end:
+        raise UserError(f"--restart: {folder} is of a run to t = {manifest.get('end')} s, this one goes to "
+                        f"{scene.time.end} s (--test given to one of them only?)")
+    for name in FILES:
+        path = folder / name
+        if not path.is_file():
+            raise UserError(f"--restart: corrupt checkpoint: {path} is missing")
+        if _sha256(path) != manifest["files"].get(name):
+            raise UserError(f"--restart: corrupt checkpoint: {path} is not the file written (SHA-256 differs: "
+                            "truncated or changed)")
+    try:
+        state = json.loads((folder / "host.json").read_text())
+        with np.load(folder / "host.npz") as arrays:
+            state.update({k: arrays[k] for k in arrays.files})
+    except (OSError, ValueError) as exc:
+        raise UserError(f"--restart: corrupt checkpoint in {folder}: {exc}") from None
+    state["restart"] = folder / RESTART
+    print(f"restart from {folder}: t = {manifest['time']:.6g} s (step {manifest['step']})")
+    return state

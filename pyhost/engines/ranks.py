@@ -1,0 +1,162 @@
+"""The host under ``mpirun -np N python -m pyhost run CASE``: LIGGGHTS' own MPI does the work.
+
+LIGGGHTS decomposes its domain over all N ranks (one LIGGGHTS on ``MPI.COMM_WORLD``, opened
+through mpi4py). The host itself (scene, loop, plugin, output, the fluid solver's link) runs
+on rank 0 only. The other ranks *follow*: they wait for rank 0's next order and make the same
+collective LIGGGHTS call (a command, a run, a variable), or hand their local atoms and contact
+rows to rank 0 (``gather``) and take back their own slice of what the host changed
+(temperatures, velocities, fluid forces: ``scatter``, in the local order they sent). So every
+collision is seen once, on rank 0, from LIGGGHTS' own contact lists (``compute
+pair/gran/local`` lists a pair that spans two ranks once, on the rank owning the atom of
+the larger id), and the total m c T is summed over all ranks' atoms.
+
+Orders are ``(name, args)`` tuples broadcast from rank 0 (mpi4py's pickled ``bcast``); each
+name is one method of :class:`Follower`. Nothing here is a parallel algorithm of ours: the
+domain decomposition, ghost exchange and migration are LIGGGHTS'.
+"""
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+
+ROOT = 0
+
+
+def world():
+    """mpi4py's COMM_WORLD when this process is one of several MPI ranks (started by
+    mpirun), else None: a serial run never imports mpi4py."""
+    size = int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)
+    if size <= 1:
+        return None
+    try:
+        from mpi4py import MPI
+    except ImportError as exc:
+        raise RuntimeError("this run has several MPI ranks but mpi4py is missing: run tools/setup.sh --engines") from exc
+    return MPI.COMM_WORLD if MPI.COMM_WORLD.Get_size() > 1 else None
+
+
+def local_atoms(lmp, temperature: bool) -> tuple:
+    """This rank's atoms as copies: id, x, v, radius, rmass, type (and Temp)."""
+    parts = [lmp.atom(name).copy() for name in ("id", "x", "v", "radius", "rmass", "type")]
+    if temperature:
+        parts.append(lmp.temperature().copy() if lmp.nlocal else np.zeros(0))
+    return tuple(parts)
+
+
+def local_values(lmp, names) -> tuple:
+    """Copies of these per-atom arrays of this rank's atoms (``Liggghts.atom`` names)."""
+    return tuple(lmp.atom(name).copy() for name in names)
+
+
+def put_by_id(lmp, ids, arrays: dict) -> None:
+    """Per-atom values given for all atoms by id: this rank's atoms take theirs."""
+    here = lmp.atom("id").astype(np.int64)
+    ids = np.asarray(ids, np.int64)
+    lookup = np.full(int(max(ids.max(initial=0), here.max(initial=0))) + 1, -1, np.int64)
+    lookup[ids] = np.arange(len(ids))
+    rows = lookup[here]
+    if np.any(rows < 0):
+        raise ValueError(f"{int(np.sum(rows < 0))} atoms of LIGGGHTS are not among the ids given")
+    for name, values in arrays.items():
+        lmp.atom(name)[:] = np.asarray(values)[rows]
+
+
+def write_local(lmp, T=None, v=None, force=None, force_fix: str | None = None) -> None:
+    """This rank's own slice of what the host changed, in the local order it sent."""
+    if T is not None and len(T):
+        lmp.temperature()[:] = T
+    if v is not None and len(v):
+        lmp.atom("v")[:] = v
+    if force is not None and lmp.nlocal:
+        lmp.external_force(force_fix)[:] = force
+
+
+class Link:
+    """Rank 0's side: orders to the followers, and the collective data exchanges."""
+
+    def __init__(self, comm):
+        self.comm = comm
+        self.size = comm.Get_size()
+        self.closed = False
+
+    def order(self, name: str, *args) -> None:
+        if self.closed:
+            raise RuntimeError(f"MPI order '{name}' after the other ranks were released")
+        self.comm.Ibarrier().Wait()        # the followers wait in theirs (see Follower.next)
+        self.comm.bcast((name, args), root=ROOT)
+
+    def gather(self, mine):
+        return self.comm.gather(mine, root=ROOT)
+
+    def scatter(self, parts):
+        return self.comm.scatter(parts, root=ROOT)
+
+    def close(self) -> None:
+        """The followers end (they close their LIGGGHTS if one is open); once."""
+        if not self.closed:
+            self.order("close")
+            self.closed = True
+
+
+class Follower:
+    """A rank other than 0: does what rank 0 orders, until ``close``."""
+
+    def __init__(self, comm):
+        self.comm, self.lmp = comm, None
+
+    def serve(self) -> int:
+        import signal
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):     # rank 0 stops the run and
+            signal.signal(sig, signal.SIG_IGN)                         # then releases the followers
+        while True:
+            name, args = self.next()
+            if name == "close":
+                if self.lmp is not None:
+                    self.lmp.close()
+                return 0
+            getattr(self, "do_" + name)(*args)
+
+    def next(self):
+        """Rank 0's next order. While rank 0 works alone (the plugin, output, the fluid solver),
+        this rank waits in a non-blocking barrier, testing it with growing pauses (to 1 ms):
+        a blocking MPI call would poll and take a core from the engines."""
+        req, pause, spun = self.comm.Ibarrier(), 0.0, time.perf_counter()
+        while not req.Test():
+            if time.perf_counter() - spun > 1e-3:          # a short busy spell first: orders come in bursts
+                pause = min(max(2 * pause, 2e-5), 1e-3)
+                time.sleep(pause)
+        return self.comm.bcast(None, root=ROOT)
+
+    def do_open(self, cwd, workdir, variables) -> None:
+        from pyhost.engines.liggghts import Liggghts
+        os.chdir(cwd)
+        self.lmp = Liggghts(workdir, variables=variables, comm=self.comm)
+
+    def do_command(self, line) -> None:
+        self.lmp.command(line)
+
+    def do_run(self, steps) -> None:
+        self.lmp.run(steps)
+
+    def do_variable(self, name) -> None:
+        self.lmp.variable(name)
+
+    def do_atoms(self, temperature) -> None:
+        self.comm.gather(local_atoms(self.lmp, temperature), root=ROOT)
+
+    def do_count(self) -> None:
+        self.comm.gather(self.lmp.nlocal, root=ROOT)
+
+    def do_local(self, compute_id) -> None:
+        self.comm.gather(self.lmp.local_array(compute_id), root=ROOT)
+
+    def do_per_atom(self, names) -> None:
+        self.comm.gather(local_values(self.lmp, names), root=ROOT)
+
+    def do_put(self, ids, arrays) -> None:
+        put_by_id(self.lmp, ids, arrays)
+
+    def do_write(self, force_fix) -> None:
+        write_local(self.lmp, *self.comm.scatter(None, root=ROOT), force_fix=force_fix)

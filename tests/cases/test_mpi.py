@@ -1,0 +1,117 @@
+"""The host under ``mpirun -np 2``: LIGGGHTS decomposes the domain over two ranks, the host on
+rank 0 sees every collision once (also a pair that spans the ranks), and the results equal the
+serial run's: exactly for one binary collision, to the chaos of a granular gas otherwise."""
+import csv
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = [pytest.mark.engines,
+              pytest.mark.skipif(shutil.which("mpirun") is None, reason="no mpirun: tools/setup.sh --engines")]
+CASES = Path(__file__).resolve().parents[2] / "cases"
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+
+def run(case, out, ranks, *extra):
+    cmd = [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(out), *extra]
+    if ranks > 1:
+        cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
+    r = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    return json.loads((out / "summary.json").read_text())
+
+
+def grid(out):
+    """LIGGGHTS' processor grid, from its own log."""
+    for line in (out / "dem" / "log.liggghts").read_text().splitlines():
+        if "MPI processor grid" in line:
+            return line.split("MPI")[0].strip()
+    return None
+
+
+def test_two_particles_across_the_rank_boundary_equal_the_serial_run(tmp_path):
+    """The two spheres start on either side of x = 0.05 m, where LIGGGHTS cuts the 0.1 m long
+    box between its two ranks: the collision is a pair of a local and a ghost atom on each
+    rank. Collision rows, history and summary must be the serial run's, bit for bit."""
+    case = tmp_path / "case"
+    shutil.copytree(CASES / "two-particles", case, ignore=shutil.ignore_patterns("output", "log.*"))
+    toml = case / "case.toml"
+    text = toml.read_text()
+    for old, new in (("[[0.045, 0.005, 0.01]]", "[[0.0478, 0.005, 0.01]]"),
+                     ("[[0.0492, 0.005, 0.01]]", "[[0.0522, 0.005, 0.01]]")):
+        assert old in text
+        text = text.replace(old, new)
+    toml.write_text(text)
+    serial = run(case, tmp_path / "np1", 1)
+    parallel = run(case, tmp_path / "np2", 2)
+    assert grid(tmp_path / "np2") == "2 by 1 by 1"
+    assert serial["collisions"] == 1
+    assert parallel == serial
+    for name in ("collisions.csv", "history.csv"):
+        assert (tmp_path / "np2" / name).read_bytes() == (tmp_path / "np1" / name).read_bytes(), name
+
+
+def test_granular_gas_on_two_ranks(tmp_path):
+    """hot-cold-box's smoke run (1000 spheres, periodic): the same collisions within the
+    chaos of the gas (the order of each sample's contacts differs, so rounding does), and
+    the heat balance to rounding on two ranks."""
+    serial = run(CASES / "hot-cold-box", tmp_path / "np1", 1, "--test")
+    parallel = run(CASES / "hot-cold-box", tmp_path / "np2", 2, "--test")
+    assert grid(tmp_path / "np2") is not None and grid(tmp_path / "np2") != "1 by 1 by 1"
+    assert parallel["status"] == "completed"
+    assert abs(parallel["energy_balance_error"]) < 1e-12
+    assert parallel["collisions"] == pytest.approx(serial["collisions"], rel=0.02)
+    assert parallel["heat_moved"] == pytest.approx(serial["heat_moved"], rel=0.02)
+    rows = list(csv.DictReader(open(tmp_path / "np2" / "collisions.csv")))
+    keys = {(min(int(r["i"]), int(r["j"])), max(int(r["i"]), int(r["j"])), r["time"]) for r in rows}
+    assert len(keys) == len(rows) == parallel["collisions"]        # each collision once, not once per rank
+
+
+STOPPER = """
+import os, signal, sys
+import pyhost.commands.run as r
+from pyhost.cli import main
+at = int(sys.argv[1])
+class Stopping:
+    def __init__(self, dem): self.dem = dem
+    def run(self, n):
+        self.dem.run(n)
+        if self.dem.step >= at: os.kill(os.getpid(), signal.SIGKILL)
+    def __getattr__(self, name): return getattr(self.dem, name)
+simulate = r.simulate
+r.simulate = lambda *a, **k: simulate(*a, wrap=Stopping, **k)
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
+    """hot-cold-box --test on two ranks with a checkpoint every 4 ms, rank 0 killed outright at
+    step 6003 (mpirun ends the job) and continued with --restart on two ranks: collisions.csv,
+    history.csv and the summary are those of the two-rank run never stopped, bit for bit."""
+    case = tmp_path / "box"
+    shutil.copytree(CASES / "hot-cold-box", case, ignore=shutil.ignore_patterns("output", "log.*"))
+    (case / "case.toml").write_text((case / "case.toml").read_text() + "\ncheckpoint = 0.004\npictures = false\n")
+    whole = run(case, tmp_path / "whole", 2, "--test")
+    mpirun = ["mpirun", "--oversubscribe", "-np", "2", sys.executable]
+    cut = subprocess.run(mpirun + ["-c", STOPPER, "6003", "run", str(case), "--test", "--out", str(tmp_path / "cut")],
+                         capture_output=True, text=True, env=ENV, timeout=600)
+    assert cut.returncode != 0 and not (tmp_path / "cut" / "summary.json").exists()
+    assert (tmp_path / "cut" / "checkpoint" / "manifest.json").is_file()
+    restarted = run(case, tmp_path / "cut", 2, "--test", "--restart")
+    assert restarted == whole
+    for name in ("collisions.csv", "history.csv"):
+        assert (tmp_path / "cut" / name).read_bytes() == (tmp_path / "whole" / name).read_bytes(), name
+
+
+def test_bad_scene_under_mpirun_exits_2_without_hanging(tmp_path):
+    """Rank 0 refuses the scene before LIGGGHTS starts and releases the other rank: the job
+    ends with rank 0's exit code and its one-line message."""
+    r = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", sys.executable, "-m", "pyhost", "run",
+                        str(tmp_path / "missing")], capture_output=True, text=True, env=ENV, timeout=120)
+    assert r.returncode == 2
+    assert "missing/case.toml: no such scene file" in r.stderr

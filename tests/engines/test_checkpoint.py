@@ -1,0 +1,218 @@
+"""Checkpoint and restart (pyhost/checkpoint.py) on the real LIGGGHTS, each run a fresh
+`python -m pyhost run` process: a run stopped (a signal, or killed outright) and continued with
+--restart gives the output of the run never stopped; a bad --restart is refused (exit 2) and
+leaves the checkpoint as it was."""
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.engines
+ROOT = Path(__file__).resolve().parents[2]
+
+# A python -m pyhost run whose DEM sends this process a signal once the DEM has passed a step:
+# a stop at a known step (a signal from outside would land anywhere).
+STOPPER = """
+import os, signal, sys
+import pyhost.commands.run as r
+from pyhost.cli import main
+at, sig = int(sys.argv[1]), getattr(signal, sys.argv[2])
+class Stopping:
+    def __init__(self, dem): self.dem = dem
+    def run(self, n):
+        self.dem.run(n)
+        if self.dem.step >= at: os.kill(os.getpid(), sig)
+    def __getattr__(self, name): return getattr(self.dem, name)
+simulate = r.simulate
+r.simulate = lambda *a, **k: simulate(*a, wrap=Stopping, **k)
+sys.exit(main(sys.argv[3:]))
+"""
+
+
+def case(tmp, name: str, checkpoint: float, every: float | None = None) -> Path:
+    """A copy of cases/<name> with checkpoints every ``checkpoint`` s and no pictures."""
+    folder = tmp / name
+    shutil.copytree(ROOT / "cases" / name, folder, ignore=shutil.ignore_patterns("output"))
+    toml = folder / "case.toml"
+    text = toml.read_text().rstrip("\n")
+    if every is not None:
+        text = text.replace("\nevery = ", "\n#every = ")
+    toml.write_text(text + f"\ncheckpoint = {checkpoint}\npictures = false\n"
+                    + (f"every = {every}\n" if every is not None else ""))
+    return folder
+
+
+def pyhost(*args, stop: tuple | None = None) -> subprocess.CompletedProcess:
+    cmd = ([sys.executable, "-c", STOPPER, str(stop[0]), stop[1]] if stop else [sys.executable, "-m", "pyhost"])
+    return subprocess.run(cmd + [str(a) for a in args], capture_output=True, text=True, cwd=ROOT, timeout=600,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT)))
+
+
+def outputs(out: Path) -> dict:
+    files = ["collisions.csv", "history.csv", "vtk/particles.pvd"] + sorted(
+        str(p.relative_to(out)) for p in (out / "vtk").glob("*.vtu"))
+    return {f: (out / f).read_bytes() for f in files}
+
+
+def summary(out: Path) -> dict:
+    return json.loads((out / "summary.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def two(tmp_path_factory):
+    """two-particles with a checkpoint every 2e-4 s, run whole once."""
+    tmp = tmp_path_factory.mktemp("two")
+    folder = case(tmp, "two-particles", 2e-4)
+    r = pyhost("run", folder, "--out", tmp / "whole")
+    assert r.returncode == 0, r.stderr[-2000:]
+    return folder, tmp / "whole"
+
+
+def test_two_particles_stopped_mid_collision_and_restarted_is_exact(two, tmp_path):
+    """SIGINT at step 3003 (t = 0.6 ms, the spheres in contact since 0.501 ms): the loop stops
+    at the end of the step (3005), checkpoints there and exits 130; --restart continues to
+    the end. Every byte of collisions.csv, history.csv and the VTK frames, and every summary
+    value, equal the run never stopped."""
+    folder, whole = two
+    out = tmp_path / "out"
+    r = pyhost("run", folder, "--out", out, stop=(3003, "SIGINT"))
+    assert r.returncode == 130, r.stderr[-2000:]
+    assert "checkpoint at t = 0.000601 s (step 3005)" in r.stdout
+    assert summary(out)["status"].startswith("stopped at t = 0.000601 s")
+    r = pyhost("run", folder, "--out", out, "--restart")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "restart from" in r.stdout
+    assert outputs(out) == outputs(whole)
+    assert summary(out) == summary(whole)
+    assert summary(out)["collisions"] == 1
+
+
+@pytest.fixture(scope="module")
+def bed(tmp_path_factory):
+    """hot-cold-box --test (1000 spheres, 10 ms, about 8200 collisions), checkpoints every
+    4 ms, run whole once."""
+    tmp = tmp_path_factory.mktemp("bed")
+    folder = case(tmp, "hot-cold-box", 0.004, every=0.002)
+    r = pyhost("run", folder, "--test", "--out", tmp / "whole")
+    assert r.returncode == 0, r.stderr[-2000:]
+    return folder, tmp / "whole"
+
+
+def test_bed_killed_and_restarted_from_its_checkpoint_is_exact(bed, tmp_path):
+    """SIGKILL at step 6003 (no clean-up at all: rows after the 4 ms checkpoint are on disk):
+    --restart from the checkpoint at step 4000 cuts them and gives the whole run bit for bit,
+    as both ran the same checkpoints."""
+    folder, whole = bed
+    out = tmp_path / "out"
+    r = pyhost("run", folder, "--test", "--out", out, stop=(6003, "SIGKILL"))
+    assert r.returncode == -9
+    assert len((out / "collisions.csv").read_bytes()) > len((whole / "collisions.csv").read_bytes()) // 2
+    r = pyhost("run", folder, "--test", "--out", out, "--restart")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "t = 0.004 s (step 4000)" in r.stdout
+    assert outputs(out) == outputs(whole)
+    assert summary(out) == summary(whole)
+
+
+def test_bed_stopped_by_sigterm_and_restarted_equals_to_its_chaos_level(bed, tmp_path):
+    """SIGTERM at step 6003 checkpoints at step 6010, a step the whole run did not checkpoint:
+    the restart rebuilds LIGGGHTS' neighbour lists and periodic images there, a change in the
+    last bits that the granular gas amplifies. Its chaos level, measured as the same scene run
+    without any checkpoint against the whole run: heat moved 2.5e-5 relative, 2 collisions of
+    8217, group temperatures 2.3e-8 K; the restart measured 3.5e-8, 0 and 2.4e-10 K.
+    Asserted: 10x the chaos level; energy conserved to rounding; rows before the stop equal."""
+    folder, whole = bed
+    out = tmp_path / "out"
+    r = pyhost("run", folder, "--test", "--out", out, stop=(6003, "SIGTERM"))
+    assert r.returncode == 143, r.stderr[-2000:]
+    assert "checkpoint at t = 0.00601 s (step 6010)" in r.stdout
+    r = pyhost("run", folder, "--test", "--out", out, "--restart")
+    assert r.returncode == 0, r.stderr[-2000:]
+    a, b = summary(out), summary(whole)
+    assert abs(a["heat_moved"] / b["heat_moved"] - 1) < 2.5e-4
+    assert abs(a["collisions"] - b["collisions"]) <= 20
+    assert abs(a["energy_balance_error"]) < 1e-14 and a["steps"] == b["steps"] and a["time"] == b["time"]
+    before = [ln for ln in (whole / "collisions.csv").read_text().splitlines()[1:] if float(ln.split(",")[0]) <= 0.006]
+    assert (out / "collisions.csv").read_text().splitlines()[1:len(before) + 1] == before
+    rows = lambda p: np.loadtxt(p, delimiter=",", skiprows=1, usecols=(5, 6))    # T_group0, T_group1
+    assert np.abs(rows(out / "history.csv") - rows(whole / "history.csv")).max() < 2.3e-7
+
+
+# -- refusals: exit 2, no engine started, the checkpoint untouched ----------------------------------
+
+def fingerprint(folder: Path) -> dict:
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())}
+
+
+def refused(capsys, *args) -> str:
+    from pyhost.cli import main
+
+    assert main([str(a) for a in args]) == 2
+    return capsys.readouterr().err
+
+
+@pytest.fixture
+def stopped(two, tmp_path):
+    """A copy of the two-particles case and of its whole run's output (with its checkpoint)."""
+    folder, whole = two
+    shutil.copytree(folder, tmp_path / "case")
+    shutil.copytree(whole, tmp_path / "out")
+    return tmp_path / "case", tmp_path / "out"
+
+
+def test_restart_without_checkpoint_is_refused(two, tmp_path, capsys):
+    folder, _ = two
+    assert "no checkpoint in" in refused(capsys, "run", folder, "--out", tmp_path / "none", "--restart")
+
+
+def damage_manifest(ck, key, value):
+    m = json.loads((ck / "manifest.json").read_text())
+    m[key] = value
+    (ck / "manifest.json").write_text(json.dumps(m))
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda case, ck: (case / "case.toml").write_text((case / "case.toml").read_text().replace("0.4 m/s", "0.5 m/s")),
+     "checkpoint of another case or of another version of"),
+    (lambda case, ck: damage_manifest(ck, "code_version", "0" * 64), "written by another code version"),
+    (lambda case, ck: (ck / "manifest.json").write_text('{"format": 1, "files": '), "corrupt checkpoint"),
+    (lambda case, ck: (ck / "host.npz").unlink(), "host.npz is missing"),
+    (lambda case, ck: os.truncate(ck / "dem.restart", 100), "dem.restart is not the file written"),
+    (lambda case, ck: (ck / "host.json").write_text("{"), "host.json is not the file written"),
+])
+def test_bad_checkpoint_is_refused_and_left_as_it_was(stopped, capsys, damage, message):
+    case_dir, out = stopped
+    ck = out / "checkpoint"
+    damage(case_dir, ck)
+    before, logs = fingerprint(ck), (out / "collisions.csv").read_bytes()
+    assert message in refused(capsys, "run", case_dir, "--out", out, "--restart")
+    assert fingerprint(ck) == before and (out / "collisions.csv").read_bytes() == logs
+
+
+def test_test_run_checkpoint_needs_test(stopped, capsys):
+    case_dir, out = stopped
+    assert "--test given to one of them only" in refused(capsys, "run", case_dir, "--out", out, "--restart", "--test")
+
+
+def test_restart_and_overwrite_together_are_refused(stopped, capsys):
+    case_dir, out = stopped
+    assert "give one" in refused(capsys, "run", case_dir, "--out", out, "--restart", "--overwrite")
+
+
+@pytest.mark.parametrize("name, why", [("silo-heat", "own LIGGGHTS script"), ("hot-cold-bed", "with a fluid")])
+def test_scripted_and_fluid_scenes_refuse_restart(tmp_path, capsys, name, why):
+    """Not built yet for these (docs/checkpoint.md): a clear refusal, for the key and for --restart."""
+    folder = tmp_path / name
+    shutil.copytree(ROOT / "cases" / name, folder, ignore=shutil.ignore_patterns("output"))
+    assert why in refused(capsys, "run", folder, "--out", tmp_path / "out", "--restart")
+    toml = folder / "case.toml"
+    toml.write_text(toml.read_text().replace("[output]", "[output]\ncheckpoint = 0.01", 1)
+                    if "[output]" in toml.read_text() else toml.read_text() + "\n[output]\ncheckpoint = 0.01\n")
+    assert "output.checkpoint: checkpoints are made for box scenes without fluid only" in refused(
+        capsys, "run", folder, "--out", tmp_path / "out2")
