@@ -14,7 +14,8 @@ Compare them as ratios: the machine may be shared.
 
 With ``--case CASE`` (e.g. cases/bed-25k): that case as it is (fluid included) for ``--time``
 s, heat as its scene says against none, with the share of OpenFOAM (collheatFoam's
-exchanges and steps, timed on rank 0) beside LIGGGHTS' and the host's.
+exchanges and steps, timed on rank 0) beside LIGGGHTS' and the host's; the fluid solver runs
+on as many ranks as LIGGGHTS (``[fluid] ranks``).
 
 Run: .venv/bin/python tools/bench_scaling.py [--particles 1000 10000 100000] [--ranks 1 2]
      [--time 2e-4] [--repeat 1] [--case cases/bed-25k]
@@ -59,8 +60,8 @@ class Timed:
 class TimedFluid:
     """The fluid solver as the loop sees it: the time inside its exchanges and steps."""
 
-    def __init__(self, fluid):
-        self.fluid, self.inside = fluid, 0.0
+    def __init__(self, fluid, counting):
+        self.fluid, self.inside, self.counting = fluid, 0.0, counting
 
     def __getattr__(self, name):
         attr = getattr(self.fluid, name)
@@ -72,7 +73,8 @@ class TimedFluid:
             try:
                 return attr(*args, **kwargs)
             finally:
-                self.inside += time.perf_counter() - t
+                if self.counting():             # from the first coupled DEM step, as the wall time
+                    self.inside += time.perf_counter() - t
         return timed
 
 
@@ -96,6 +98,8 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
     else:
         base = load_scene(Path(os.environ["BENCH_CASE"]).resolve() / "case.toml")
         scene = variant(base, sim_time, contact_heat=heat)
+        if scene.fluid is not None:     # the fluid on as many ranks as LIGGGHTS
+            scene = dataclasses.replace(scene, fluid=dataclasses.replace(scene.fluid, ranks=len(ranks_of(comm))))
     timed = {}
 
     def wrap(dem):
@@ -103,7 +107,7 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
         return timed["dem"]
 
     def wrap_fluid(fluid):
-        timed["fluid"] = TimedFluid(fluid)
+        timed["fluid"] = TimedFluid(fluid, lambda: "dem" in timed and timed["dem"].started is not None)
         return timed["fluid"]
 
     try:
@@ -121,6 +125,10 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
                           in_fluid=timed["fluid"].inside if "fluid" in timed else 0.0,
                           collisions=summary["collisions"], rss_max_mb=max(rss) / 1024, rss_sum_mb=sum(rss) / 1024,
                           balance=summary.get("energy_balance_error"))))
+
+
+def ranks_of(comm) -> range:
+    return range(comm.Get_size() if comm is not None else 1)
 
 
 def measure(n: int, ranks: int, sim_time: float, heat: str, tmp: Path, case: Path | None = None) -> dict:
