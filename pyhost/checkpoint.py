@@ -6,10 +6,12 @@ coupling loop calls :func:`write` at the end of a step. It writes OUT/.checkpoin
 - ``dem.restart``: LIGGGHTS' ``write_restart`` (atoms, the per-atom ``Temp`` of ``fix
   property/atom Temp ... restart yes``, the tangential contact history of ``fix
   contacthistory`` and of the primitive walls);
-- ``host.npz``: the host's arrays (open contacts with their start, t_coll, e, v0 and normal;
+- ``host.npz``: the host's arrays (open contacts' keys and, aligned, their start, t_coll, e, v0
+  and normal;
   m c T by id; the ids seen) and each atom's force and torque of the last step;
 - ``host.json``: the host's values (totals, CT0, steps, warnings given, the byte size of
-  collisions.csv and history.csv and the VTK frames at this step);
+  collisions.csv, or the rows of the binary collision log, and of history.csv, and the VTK
+  frames at this step);
 - ``manifest.json`` last: the scene file's SHA-256, the code version (SHA-256 of pyhost/ and
   plugins/ sources), step, time, the run's end, and the SHA-256 of each file above;
 

@@ -17,7 +17,8 @@ import sys
 from pyhost.exitcodes import classify
 from pyhost.signals import stopping
 
-COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench", "post", "compare")
+COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench", "post", "compare",
+            "collisions")
 
 
 class UserError(Exception):

@@ -36,23 +36,39 @@ class ContactTracker:
     """The open contacts between two samples of the contact list.
 
     ``update(keys)`` returns the indices (into keys) of contacts that opened since the last
-    sample and the keys of those that closed (in the order of the last sample); the host
-    stores per-contact data alongside. Membership by binary search in sorted copies.
+    sample and the keys of those that closed (in the order of the last sample); ``match(keys)``
+    also says where each contact was in the last sample, so that the host keeps per-contact
+    data in arrays aligned with ``open_keys``. Membership by binary search in sorted copies.
     """
 
     def __init__(self):
         self.open_keys = np.empty(0, np.int64)
         self._sorted = self.open_keys
+        self._order = np.empty(0, np.intp)
 
-    def update(self, keys: np.ndarray):
+    def match(self, keys: np.ndarray):
+        """(opened: indices into keys of the new contacts; closed: indices into the last
+        ``open_keys`` of those gone, in order; prev: for each key its index in the last
+        ``open_keys``, -1 for a new one); ``open_keys`` becomes a copy of keys."""
         keys = np.asarray(keys, np.int64)
-        ordered = np.sort(keys)
+        order = np.argsort(keys, kind="stable")
+        ordered = keys[order]
         if np.any(ordered[1:] == ordered[:-1]):
             raise ValueError("contact list holds the same contact twice (is newton off?)")
-        opened = np.flatnonzero(~_member(keys, self._sorted))
-        closed = self.open_keys[~_member(self.open_keys, ordered)]
-        self.open_keys, self._sorted = keys.copy(), ordered
-        return opened, closed
+        prev = np.full(len(keys), -1, np.intp)
+        if len(self._sorted):
+            at = np.minimum(np.searchsorted(self._sorted, keys), len(self._sorted) - 1)
+            hit = self._sorted[at] == keys
+            prev[hit] = self._order[at[hit]]
+        opened = np.flatnonzero(prev < 0)
+        closed = np.flatnonzero(~_member(self.open_keys, ordered))
+        self.open_keys, self._sorted, self._order = keys.copy(), ordered, order
+        return opened, closed, prev
+
+    def update(self, keys: np.ndarray):
+        old = self.open_keys
+        opened, closed, _ = self.match(keys)
+        return opened, old[closed]
 
 
 def _member(values, ordered):

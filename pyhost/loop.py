@@ -22,7 +22,6 @@ classified (collision, then enduring) is told in ``pyhost.collisions``.
 """
 from __future__ import annotations
 
-import itertools
 import json
 import math
 from dataclasses import dataclass
@@ -39,10 +38,13 @@ from pyhost.engines.dem import Dem
 from pyhost.failures import particles_lost
 from pyhost.engines.liggghts import LiggghtsError
 from pyhost.outdir import write_atomic
-from pyhost.output import CsvLog, Progress, VtkSeries
+from pyhost.output import ColumnLog, CsvLog, Progress, VtkSeries, collision_kinds
 from pyhost.script import ScriptError, parse_run
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
+OPEN_COLUMNS = ("start", "t_coll", "e", "v0", "nx", "ny", "nz")
+"""What the host keeps of each open contact: start time [s], model duration [s], the model's
+restitution (NaN: none to impose), impact speed [m/s] and unit normal at the start."""
 FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
 GAS_COLUMNS = ("T_gas_mean", "gas_energy", "heat_convected", "heat_convected_gross", "heat_through_fluid_boundaries",
                "heat_moved")
@@ -97,7 +99,7 @@ class Coupling:
         self.update_walls(walls)
         self.capacity = np.array([m.heat_capacity for m in self.materials])
         self.tracker = ContactTracker()
-        self.open = {}                   # contact key -> (start time, model t_coll, e, v0, normal)
+        self.info = np.empty((0, len(OPEN_COLUMNS)))   # per open contact, rows aligned with tracker.open_keys
         self.t0_step = dem.step
         self.t = dem.step * dem.dt
         self.steps = 0
@@ -118,8 +120,10 @@ class Coupling:
             self.CT0 = self.totals.pop("energy_in")
             self.totals["energy_in"] = 0.0
         logs = resume["logs"] if resume else {}
-        self.collisions = CsvLog(self.out / "collisions.csv", COLLISION_COLUMNS
-                                 + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:]), logs.get("collisions"))
+        columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
+        self.collisions = (ColumnLog(self.out / "collisions", collision_kinds(columns), logs.get("collisions"))
+                           if scene.output.collisions == "binary"
+                           else CsvLog(self.out / "collisions.csv", columns, logs.get("collisions")))
         self.history = CsvLog(self.out / "history.csv", ("time", "particles", "T_mean", "T_min", "T_max")
                               + tuple(f"T_group{k}" for k in range(len(self.group_names)))
                               + ("sum_mcT", "heat_from_walls", "energy_in", "energy_out", "collisions",
@@ -224,13 +228,12 @@ class Coupling:
     # -- checkpoint (pyhost.checkpoint writes and reads the files) ---------------------------
     def state(self) -> tuple[dict, dict]:
         """The host's state at the end of a step: (JSON values, arrays)."""
-        info = np.array([v[:4] + tuple(v[4]) for v in self.open.values()]).reshape(-1, 7)
         logs = dict(collisions=self.collisions.size, history=self.history.size,
                     particles=self.frames.frames if self.frames is not None else None)
         values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, CT0=self.CT0,
                       gas_energy0=getattr(self, "gas_energy0", 0.0), warned=sorted(self.warned), logs=logs)
-        arrays = dict(open_keys=self.tracker.open_keys, contact_keys=np.array(list(self.open), np.int64),
-                      contact_info=info, CT_by_id=self.CT_by_id, seen=self.seen)
+        arrays = dict(open_keys=self.tracker.open_keys, contact_info=self.info, CT_by_id=self.CT_by_id,
+                      seen=self.seen)
         return values, arrays
 
     def restore(self, state: dict) -> None:
@@ -239,8 +242,7 @@ class Coupling:
             setattr(self, name, state[name])
         self.totals, self.warned = state["totals"], set(state["warned"])
         self.tracker.update(state["open_keys"])
-        self.open = {k: (*v[:4].tolist(), v[4:].tolist())
-                     for k, v in zip(state["contact_keys"].tolist(), state["contact_info"])}
+        self.info = np.asarray(state["contact_info"], float).reshape(-1, len(OPEN_COLUMNS))
         self.CT_by_id, self.seen = state["CT_by_id"], state["seen"]
         checkpoint.restore_forces(self.dem, state)
 
@@ -289,13 +291,17 @@ class Coupling:
     def sample_contacts(self, atoms) -> None:
         c = self.dem.contacts(atoms, self.wall_index)
         keys = contact_keys(c.i, c.j)
-        opened, closed = self.tracker.update(keys)
+        last_keys, last = self.tracker.open_keys, self.info
+        opened, closed, prev = self.tracker.match(keys)
+        self.info = np.empty((len(keys), len(OPEN_COLUMNS)))
+        kept = prev >= 0
+        self.info[kept] = last[prev[kept]]
         if len(opened):
             self.start_collisions(atoms, c, keys, opened)
         if len(closed):
-            self.end_collisions(atoms, closed)
+            self.end_collisions(atoms, last_keys[closed], last[closed])
         if self.heat and self.dem.info.heat_gran and len(c):
-            self.undo_heat_gran(atoms, c, keys)
+            self.undo_heat_gran(atoms, c)
 
     def open_present(self) -> None:
         """The contacts present now count as open, enduring (t_coll 0: no collision time to
@@ -303,9 +309,9 @@ class Coupling:
         c = self.dem.contacts(self.dem.atoms(self.heat), self.wall_index)
         keys = contact_keys(c.i, c.j)
         self.tracker.update(keys)
-        self.open.update(zip(keys.tolist(), zip(itertools.repeat(self.t), itertools.repeat(0.0),
-                                                itertools.repeat(math.nan), itertools.repeat(math.nan),
-                                                c.normal.tolist())))
+        n = len(keys)
+        self.info = np.column_stack([np.full(n, self.t), np.zeros(n), np.full(n, math.nan), np.full(n, math.nan),
+                                     np.asarray(c.normal, float).reshape(n, 3)])
 
     def dem_law(self, a: int, b: int) -> DemHertz:
         """The DEM's Hertz law between atom types a and b, from the script's own values
@@ -380,8 +386,7 @@ class Coupling:
             by_model = self.heat_by_model()
             for m, q in zip(models, [moved] + list(side.values())):
                 by_model[m] += float(np.abs(q[~wall]).sum())
-        self.open.update(zip(keys[rows].tolist(), zip(itertools.repeat(self.t), t_coll.tolist(), e.tolist(),
-                                                     v0.tolist(), c.normal[rows].tolist())))
+        self.info[rows] = np.column_stack([np.full(len(rows), self.t), t_coll, e, v0, c.normal[rows]])
         self.totals["collisions"] += len(rows)
         self.totals["particle_wall"] += int(wall.sum())
         self.totals["particle_particle"] += int((~wall).sum())
@@ -395,24 +400,25 @@ class Coupling:
         that moved it and the side models on the same collisions."""
         return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
 
-    def end_collisions(self, atoms, closed) -> None:
-        info = [self.open.pop(k) for k in closed.tolist()]
+    def end_collisions(self, atoms, closed, info) -> None:
+        """Contacts gone since the last sample (their keys and OPEN_COLUMNS rows): with
+        restitution feedback, the model's e imposed on the pair's normal velocity."""
         if not self.scene.effects.restitution_feedback or not self.heat:
             return
         ids_i = (closed >> 31).astype(np.int64)
         ids_j = (closed & ((1 << 31) - 1)).astype(np.int64)
         i = atoms.index(ids_i)
-        e = np.array([inf[2] for inf in info])
+        e = info[:, 2]
         here = (i >= 0) & ~np.isnan(e)         # contacts there at a restart: no collision
         wall, jl, _, _, _, m_j = self.partners(atoms, np.maximum(i, 0), ids_j)
         here &= wall | (jl >= 0)
-        normal = np.array([inf[4] for inf in info]).reshape(-1, 3)
+        normal = info[:, 4:7].copy()
         jj = np.where(wall, 0, np.maximum(jl, 0))
         d = atoms.x[np.maximum(i, 0)] - atoms.x[jj]
         lo, hi, periodic = self.dem.box()
         d = np.where(periodic, d - (hi - lo) * np.round(d / (hi - lo)), d)
         normal[~wall] = d[~wall] / np.linalg.norm(d[~wall], axis=1)[:, None]
-        v0 = np.array([inf[3] for inf in info])
+        v0 = info[:, 3]
         v_j = np.where(wall[:, None], 0.0, atoms.v[jj])
         dv_i, dv_j, clipped = restitution_impulse(atoms.v[np.maximum(i, 0)], v_j, atoms.mass[np.maximum(i, 0)],
                                                   m_j, normal, e, v0)
@@ -422,15 +428,13 @@ class Coupling:
         if pair.any():
             self.dem.add_velocity(jl[pair], dv_j[pair])
 
-    def undo_heat_gran(self, atoms, c, keys) -> None:
+    def undo_heat_gran(self, atoms, c) -> None:
         """The script's fix heat/gran conducts through every contact; during a collision's
         model duration t_coll the collision heat already stands for that time, so what heat/gran
         moved then is taken back: flux at this sample [W] times the part of the sample interval
         inside [start, start + t_coll] (exact when sampling every step)."""
         dt_s = self.every["sample"] * self.dem.dt
-        info = [self.open[k] for k in keys.tolist()]
-        start = np.array([inf[0] for inf in info])
-        t_coll = np.array([inf[1] for inf in info])
+        start, t_coll = self.info[:, 0], self.info[:, 1]
         tau = np.clip(start + t_coll - (self.t - dt_s), 0.0, dt_s)
         rows = np.flatnonzero((tau > 0) & (c.j < WALL_BASE))
         if not len(rows):

@@ -12,7 +12,7 @@ from pathlib import Path
 from pyhost.cli import UserError
 
 # What ``python -m pyhost run`` writes; an overwrite removes these and nothing else.
-RUN_FILES = ("summary.json", "scene.json", "collisions.csv", "history.csv", "vtk", "dem", "fluid",
+RUN_FILES = ("summary.json", "scene.json", "collisions.csv", "collisions", "history.csv", "vtk", "dem", "fluid",
              "temperatures.png", "particles.png",
              "checkpoint", ".checkpoint.new", ".checkpoint.old")
 

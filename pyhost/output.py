@@ -1,6 +1,9 @@
 """What a run leaves on disk, written as it goes so that a crash or an interrupt keeps it.
 
 - ``CsvLog``: rows appended and flushed at every write (collisions, history);
+- ``ColumnLog``: the same rows as one raw little-endian file per column and a JSON schema
+  (the collisions with ``output.collisions = "binary"``); ``read_collisions`` reads either
+  form as numpy arrays, ``collisions_to_csv`` writes the CSV form of a binary log;
 - ``VtkSeries``: one .vtu per frame (meshio) and a .pvd index rewritten after each frame,
   so ParaView and pyvista (``pyvista.read(...pvd)``) open whatever was written;
 - ``Progress``: one line every few seconds of wall time: simulated time, rate, time left.
@@ -8,6 +11,7 @@
 from __future__ import annotations
 
 import csv
+import json
 import os
 import sys
 import time
@@ -51,6 +55,172 @@ class CsvLog:
 
     def close(self) -> None:
         self._file.close()
+
+
+SCHEMA, COLUMN_FORMAT = "schema.json", 1
+
+
+class ColumnLog:
+    """Rows as columns: in ``folder``, one raw little-endian file per column, ``NAME.f8``
+    (float64), ``NAME.i8`` (int64) or, for text, ``NAME.u2`` (uint16 codes into the schema's
+    ``categories`` of that column), and ``schema.json`` (columns, kinds, categories; rewritten
+    atomically when a new text value appears). ``write_columns`` appends and flushes every file.
+    ``kinds``: column -> "f8", "i8" or "str". ``resume_at``: the rows at a checkpoint: each
+    file is cut to that many rows, and rows follow them. numpy.fromfile / memmap read a column
+    (``read_columns``)."""
+
+    def __init__(self, folder: Path, kinds: dict, resume_at: int | None = None):
+        self.folder, self.columns = Path(folder), tuple(kinds)
+        self.kinds = dict(kinds)
+        bad = {c: k for c, k in self.kinds.items() if k not in ("f8", "i8", "str")}
+        if bad:
+            raise ValueError(f"ColumnLog: unknown column kinds {bad} (f8, i8, str)")
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.categories = {c: [] for c, k in self.kinds.items() if k == "str"}
+        if resume_at is not None:
+            old = json.loads((self.folder / SCHEMA).read_text())
+            self.categories.update({c["name"]: list(c.get("categories", [])) for c in old["columns"]
+                                    if c["name"] in self.categories})
+        self.rows = 0 if resume_at is None else int(resume_at)
+        self._code = {c: {v: k for k, v in enumerate(cats)} for c, cats in self.categories.items()}
+        self._files = {}
+        for c in self.columns:
+            path = self.folder / self._file_name(c)
+            if resume_at is not None:
+                os.truncate(path, self.rows * _DTYPES[self.kinds[c]].itemsize)
+            self._files[c] = open(path, "ab" if resume_at is not None else "wb")
+        self._schema()
+
+    @staticmethod
+    def _file_name_of(name: str, kind: str) -> str:
+        return f"{name}.{'u2' if kind == 'str' else kind}"
+
+    def _file_name(self, c: str) -> str:
+        return self._file_name_of(c, self.kinds[c])
+
+    def _schema(self) -> None:
+        from pyhost.outdir import write_atomic
+        cols = [dict(name=c, kind=self.kinds[c], file=self._file_name(c),
+                     **({"categories": self.categories[c]} if c in self.categories else {})) for c in self.columns]
+        write_atomic(self.folder / SCHEMA, json.dumps(dict(format=COLUMN_FORMAT, byteorder="little",
+                                                            columns=cols), indent=1))
+
+    @property
+    def size(self) -> int:
+        """Rows written so far (all flushed): what ``resume_at`` takes."""
+        return self.rows
+
+    def write_columns(self, **arrays) -> None:
+        """Rows from equal-length arrays named by the columns."""
+        n = len(arrays[self.columns[0]]) if self.columns else 0
+        if not n:
+            return
+        new = False
+        for c in self.columns:
+            a = np.asarray(arrays[c])
+            if len(a) != n:
+                raise ValueError(f"ColumnLog: column {c} has {len(a)} rows, {self.columns[0]} has {n}")
+            if self.kinds[c] == "str":
+                values, inverse = np.unique(a.astype(str), return_inverse=True)
+                codes = self._code[c]
+                for v in values.tolist():
+                    if v not in codes:
+                        codes[v] = len(self.categories[c])
+                        self.categories[c].append(v)
+                        new = True
+                a = np.array([codes[v] for v in values.tolist()], "<u2")[inverse.ravel()]
+            else:
+                a = a.astype(_DTYPES[self.kinds[c]], copy=False)
+            self._files[c].write(a.tobytes())
+        if new:
+            self._schema()
+        for f in self._files.values():
+            f.flush()
+        self.rows += n
+
+    def close(self) -> None:
+        for f in self._files.values():
+            f.close()
+
+
+_DTYPES = {"f8": np.dtype("<f8"), "i8": np.dtype("<i8"), "str": np.dtype("<u2")}
+
+
+def read_columns(folder: Path) -> dict:
+    """The columns of a ``ColumnLog`` folder: name -> numpy array (text columns as str
+    arrays), in the schema's order; ValueError naming the file if a column is short or the
+    schema unreadable."""
+    folder = Path(folder)
+    try:
+        schema = json.loads((folder / SCHEMA).read_text())
+        cols = schema["columns"]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ValueError(f"{folder / SCHEMA}: not a column log schema ({exc})") from None
+    out, rows = {}, None
+    for c in cols:
+        dtype = _DTYPES[c["kind"]]
+        path = folder / c["file"]
+        size = path.stat().st_size
+        if size % dtype.itemsize:
+            raise ValueError(f"{path}: {size} bytes, not a whole number of {dtype.itemsize}-byte values")
+        a = np.fromfile(path, dtype)
+        rows = len(a) if rows is None else rows
+        if len(a) != rows:
+            raise ValueError(f"{path}: {len(a)} rows, {cols[0]['file']} has {rows}")
+        if c["kind"] == "str":
+            cats = np.array(c.get("categories", []) or [""], str)
+            if len(a) and a.max() >= len(cats):
+                raise ValueError(f"{path}: code {int(a.max())} beyond the schema's {len(cats)} categories")
+            a = cats[a]
+        out[c["name"]] = a
+    return out
+
+
+COLLISION_KINDS = dict(time="f8", i="i8", j="i8", wall="i8", v0="f8", Q="f8", e="f8", t_coll="f8", model="str")
+"""The kind of each collisions column; side columns Q_<model> are f8."""
+
+
+def collision_kinds(columns) -> dict:
+    return {c: COLLISION_KINDS.get(c, "f8") for c in columns}
+
+
+def read_collisions(out: Path) -> dict:
+    """The collisions of a run's output folder as column name -> numpy array, from the binary
+    form (OUT/collisions/) if there is one, else from OUT/collisions.csv: i, j, wall int64,
+    model str, the others float64; both forms give the same values bit for bit.
+    FileNotFoundError naming both if the run wrote neither."""
+    out = Path(out)
+    if (out / "collisions" / SCHEMA).is_file():
+        return read_columns(out / "collisions")
+    path = out / "collisions.csv"
+    if not path.is_file():
+        raise FileNotFoundError(f"{out}: no collisions (neither collisions.csv nor collisions/{SCHEMA})")
+    with open(path, newline="") as f:
+        reader = csv.reader(f)
+        header = next(reader, None)
+        if header is None:
+            raise ValueError(f"{path}: empty (no header)")
+        rows = list(reader)
+    text = np.array(rows, str).reshape(-1, len(header))
+    kinds = collision_kinds(header)
+    return {c: text[:, k] if kinds[c] == "str" else text[:, k].astype(_DTYPES[kinds[c]].newbyteorder("="))
+            for k, c in enumerate(header)}
+
+
+def collisions_to_csv(out: Path, target: Path | None = None, chunk: int = 1 << 20) -> Path:
+    """OUT/collisions.csv (or ``target``) from the binary form OUT/collisions/, byte for byte
+    the file the run would have written with ``output.collisions = "csv"``; returns its path."""
+    out = Path(out)
+    cols = read_columns(out / "collisions")
+    target = Path(target) if target else out / "collisions.csv"
+    tmp = target.with_name(target.name + ".tmp")
+    log = CsvLog(tmp, tuple(cols))
+    n = len(next(iter(cols.values()))) if cols else 0
+    for a in range(0, n, chunk):
+        log.write_columns(**{c: v[a:a + chunk] for c, v in cols.items()})
+    log.close()
+    tmp.replace(target)
+    return target
 
 
 class VtkSeries:

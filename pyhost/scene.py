@@ -224,6 +224,10 @@ class Output:
     checkpoint: float = spec(">=0", 0.0, "simulated time between checkpoints into OUT/checkpoint, also written "
                              "when a signal stops the run; continue with 'run CASE --restart' [s]; 0: none. "
                              "Box scenes without fluid only (docs/checkpoint.md)")
+    collisions: str = spec("in:csv,binary", "csv", "form of the collision log: 'csv', OUT/collisions.csv; 'binary', "
+                           "one raw little-endian file per column in OUT/collisions/ with schema.json (cheaper "
+                           "to write; read with pyhost.output.read_collisions, convert with "
+                           "'python -m pyhost collisions OUT')")
 
 
 @dataclass(frozen=True)

@@ -65,6 +65,7 @@ from bench_host import Clocked
 from pyhost.commands.run import simulate, start_fluid
 from pyhost.dem_input import place_particles
 from pyhost.loop import layer_pressure_drop
+from pyhost.output import read_collisions
 from pyhost.scene import load_scene
 
 CASE = Path(__file__).resolve().parents[1] / "cases" / "hot-cold-bed" / "case.toml"
@@ -103,9 +104,10 @@ class Probe:
         self.fluid.advance(duration, steps)
         return forces
 
-    def count(self, collisions_csv: Path) -> None:
-        """N: collisions, Q: heat moved between particles [J] (sum of |Q|) up to each snapshot."""
-        c = np.genfromtxt(collisions_csv, delimiter=",", names=True, usecols=("time", "wall", "Q"), ndmin=1)
+    def count(self, out: Path) -> None:
+        """N: collisions, Q: heat moved between particles [J] (sum of |Q|) up to each snapshot
+        (the run's collision log in ``out``, CSV or binary)."""
+        c = read_collisions(out)
         for s in self.snaps:
             upto = c["time"] <= s["t"] * (1 + 1e-9)
             s["N"] = int(upto.sum())
@@ -138,7 +140,7 @@ def run(scene, out: Path, particles=None, record: bool = False, nudge: float = 0
     wall = time.perf_counter() - engines["dem"].started - (probe.overhead if probe else 0.0)
     final = None
     if probe:
-        probe.count(out / "collisions.csv")
+        probe.count(out)
         last = probe.snaps[-1]           # the run ends on a snapshot: its time is a multiple of STRIDE;
         # in particle order: box scenes keep LIGGGHTS' local order (atom_modify sort 0 0, one process)
         final = dataclasses.replace(particles_at_start, position=last["x"], velocity=last["v"])

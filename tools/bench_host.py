@@ -13,15 +13,18 @@ the script's set-up commands), except in section 2.
    time per DEM step without heat and with heat A (fast path), their ratio, and the cost
    per collision (extra wall time / collisions); with ``--baseline TREE`` the same on the
    code of another checkout (``tools/bench_host_baseline.py`` run with PYTHONPATH=TREE),
-   so that before and after come from one run.
+   so that before and after come from one run. ``--collisions csv binary``: section 4 with
+   each form of the collision log (output.collisions); a baseline without that key is run
+   with its CSV only.
 
-Run: .venv/bin/python tools/bench_host.py [--time 0.01] [--sections 1 2 3 4]
-     [--particles 1000 8000 27000] [--size-time 0.002] [--repeat 1] [--baseline /path/to/old/checkout]
+Run (PYTHONPATH: the checkout to measure; the .venv's editable install points at /work/main):
+     PYTHONPATH=. .venv/bin/python tools/bench_host.py [--time 0.01] [--sections 1 2 3 4]
+     [--particles 1000 8000 27000] [--size-time 0.002] [--repeat 1] [--collisions csv binary]
+     [--baseline /path/to/old/checkout]
 """
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
 import json
 import os
@@ -40,11 +43,14 @@ from pyhost.scene import load_scene
 CASE = Path(__file__).resolve().parents[1] / "cases" / "hot-cold-box" / "case.toml"
 
 
-def variant(scene, end, **effects):
+def variant(scene, end, collisions: str = "csv", **effects):
+    """The scene to ``end`` [s] with these effects, no VTK or pictures; ``collisions``: the
+    form of the collision log (left out for "csv", so that older checkouts run it too)."""
+    form = {} if collisions == "csv" else dict(collisions=collisions)
     return dataclasses.replace(
         scene, effects=dataclasses.replace(scene.effects, **effects),
         time=dataclasses.replace(scene.time, end=end),
-        output=dataclasses.replace(scene.output, vtk=False, pictures=False, every=end))
+        output=dataclasses.replace(scene.output, vtk=False, pictures=False, every=end, **form))
 
 
 def scaled(scene, n: int):
@@ -61,10 +67,10 @@ def scaled(scene, n: int):
     return dataclasses.replace(scene, particles=groups, domain=dataclasses.replace(scene.domain, box=grow(scene.domain.box)))
 
 
-def heat_by_size(run_host, sizes, sim_time: float, tmp: Path, repeat: int = 1) -> list[dict]:
-    """For each size: wall time per DEM step [s] plain and with heat A (fast), best of
-    ``repeat`` runs of each taken in turns, and the collisions. A short run of each first, so
-    that no row pays for loading libraries."""
+def heat_by_size(run_host, sizes, sim_time: float, tmp: Path, repeat: int = 1, forms=("csv",)) -> list[dict]:
+    """For each size: wall time per DEM step [s] plain and with heat A (fast) with each form
+    of the collision log in ``forms``, best of ``repeat`` runs of each taken in turns, and the
+    collisions. A short run of each first, so that no row pays for loading libraries."""
     base = load_scene(CASE)
     for heat in ("none", "A"):
         run_host(variant(base, 10 * base.time.dem_step, contact_heat=heat), tmp / f"warm-{heat}")
@@ -72,21 +78,24 @@ def heat_by_size(run_host, sizes, sim_time: float, tmp: Path, repeat: int = 1) -
     for n in sizes:
         sc = scaled(base, n)
         steps = round(sim_time / sc.time.dem_step)
-        walls = {"none": [], "A": []}
+        walls = {("none", "csv"): []} | {("A", form): [] for form in forms}
         for r in range(repeat):
-            for heat in walls:
-                wall, summary = run_host(variant(sc, sim_time, contact_heat=heat, heat_path="fast"),
-                                         tmp / f"{heat}{n}-{r}")
-                walls[heat].append(wall)
-        rows.append(dict(particles=sum(g.count for g in sc.particles), steps=steps, plain=min(walls["none"]) / steps,
-                         heat=min(walls["A"]) / steps, collisions=summary["collisions"]))
+            for heat, form in walls:
+                wall, summary = run_host(variant(sc, sim_time, form, contact_heat=heat, heat_path="fast"),
+                                         tmp / f"{heat}{n}-{form}-{r}")
+                shutil.rmtree(tmp / f"{heat}{n}-{form}-{r}", ignore_errors=True)
+                walls[heat, form].append(wall)
+        for form in forms:
+            rows.append(dict(particles=sum(g.count for g in sc.particles), steps=steps, form=form,
+                             plain=min(walls["none", "csv"]) / steps, heat=min(walls["A", form]) / steps,
+                             collisions=summary["collisions"]))
     return rows
 
 
 def size_table(rows: list[dict], label: str) -> None:
     for r in rows:
         extra = (r["heat"] - r["plain"]) * r["steps"]
-        print(f"{label:>8} | {r['particles']:>9} | {1e3 * r['plain']:11.3f} | {1e3 * r['heat']:11.3f} | "
+        print(f"{label:>8} | {r.get('form', 'csv'):>6} | {r['particles']:>9} | {1e3 * r['plain']:11.3f} | {1e3 * r['heat']:11.3f} | "
               f"{r['heat'] / r['plain']:5.2f} | {r['collisions']:>10} | {1e6 * extra / max(r['collisions'], 1):8.1f}")
 
 
@@ -134,8 +143,11 @@ def run_native(scene, out: Path) -> float:
 def collisions(out: Path) -> dict:
     """Collisions by partners: {(i, j, wall): [(start time, v0), ...]}."""
     found = {}
-    for r in csv.DictReader(open(out / "collisions.csv")):
-        found.setdefault((int(r["i"]), int(r["j"]), int(r["wall"])), []).append((float(r["time"]), float(r["v0"])))
+    from pyhost.output import read_collisions       # here: a baseline checkout may lack it
+
+    c = read_collisions(out)
+    for i, j, w, t, v0 in zip(*(c[k].tolist() for k in ("i", "j", "wall", "time", "v0"))):
+        found.setdefault((i, j, w), []).append((t, v0))
     return found
 
 
@@ -162,8 +174,16 @@ def main() -> None:
                     help="section 4: particle counts (the scene grown at its packing)")
     ap.add_argument("--size-time", type=float, default=0.002, help="section 4: simulated time per run [s]")
     ap.add_argument("--repeat", type=int, default=1, help="section 4: runs of each (best of)")
+    ap.add_argument("--collisions", nargs="+", default=["csv"], choices=["csv", "binary"],
+                    help="section 4: forms of the collision log with heat on")
     ap.add_argument("--baseline", type=Path, help="section 4 also on this checkout's code (before/after)")
+    ap.add_argument("--rows-json", action="store_true", help=argparse.SUPPRESS)   # the baseline's own process
     args = ap.parse_args()
+    if args.rows_json:
+        with tempfile.TemporaryDirectory() as tmp:
+            print(json.dumps(heat_by_size(run_host, args.particles, args.size_time, Path(tmp), args.repeat,
+                                          args.collisions)))
+        return
     base = load_scene(CASE)
     n = len(place_particles(base).radius)
     print(f"scene: {CASE.parent.name}, {n} particles, DEM step {base.time.dem_step:g} s, "
@@ -180,19 +200,26 @@ def main() -> None:
             print(f"\n4. heat A (fast path) against plain DEM, {args.size_time:g} s simulated "
                   f"({round(args.size_time / base.time.dem_step)} steps) per run, engines' set-up not counted, "
                   f"best of {args.repeat}")
-            print(f"{'code':>8} | {'particles':>9} | {'plain ms/st':>11} | {'heat ms/st':>11} | ratio | "
+            print(f"{'code':>8} | {'log':>6} | {'particles':>9} | {'plain ms/st':>11} | {'heat ms/st':>11} | ratio | "
                   f"{'collisions':>10} | {'us/coll':>8}")
-            size_table(heat_by_size(run_host, args.particles, args.size_time, tmp, args.repeat), "this")
             if args.baseline:
                 size_table(baseline_sizes(args.baseline, args.particles, args.size_time, args.repeat), "baseline")
+            size_table(heat_by_size(run_host, args.particles, args.size_time, tmp, args.repeat, args.collisions),
+                       "this")
 
 
 def baseline_sizes(tree: Path, sizes, sim_time: float, repeat: int) -> list[dict]:
-    """Section 4 on the code of another checkout, in a process of its own."""
+    """Section 4 on the code of another checkout (CSV log), in a process of its own: this
+    script itself for a checkout with ``pyhost.commands.run.simulate``, else
+    ``bench_host_baseline.py`` (the code before the LIGGGHTS-script rewrite)."""
     env = dict(os.environ, PYTHONPATH=str(tree.resolve()))
-    done = subprocess.run([sys.executable, str(Path(__file__).with_name("bench_host_baseline.py")),
-                           str(sim_time), str(repeat)] + [str(n) for n in sizes], env=env, check=True, stdout=subprocess.PIPE,
-                          text=True)
+    current = "def simulate(" in (tree / "pyhost" / "commands" / "run.py").read_text() \
+        if (tree / "pyhost" / "commands" / "run.py").is_file() else False
+    cmd = ([sys.executable, __file__, "--rows-json", "--size-time", str(sim_time), "--repeat", str(repeat),
+            "--particles"] + [str(n) for n in sizes] if current else
+           [sys.executable, str(Path(__file__).with_name("bench_host_baseline.py")), str(sim_time), str(repeat)]
+           + [str(n) for n in sizes])
+    done = subprocess.run(cmd, env=env, check=True, stdout=subprocess.PIPE, text=True)
     return json.loads(done.stdout.splitlines()[-1])
 
 

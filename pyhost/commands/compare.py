@@ -93,7 +93,7 @@ def run(args) -> int:
         print(f"{name:>10} {E:10.0e} " + " ".join(f"{x:>{w}.3g}" for x, w in zip(r, (11, 15, 12, 16, 8, 11))))
 
     bed = None
-    if (args.bed / "collisions.csv").is_file():
+    if has_collisions(args.bed):
         bed = bed_totals(args.bed, MODEL_NAMES)
         write_csv(args.out / "comparison_bed.csv", {"model": list(bed), "heat_J": list(bed.values())})
         print(f"(c) {args.bed}: heat between particles [J] on the run's {bed.pop('_collisions')} collisions")
@@ -112,11 +112,18 @@ def bed_totals(run_dir: Path, models) -> dict:
     from pyhost.contact_heat import heat_by_model_offline
     from pyhost.scene import load_scene
 
-    with open(run_dir / "collisions.csv") as f:
-        rows = list(csv.DictReader(f))
-    cols = {k: np.array([r[k] for r in rows]) for k in ("i", "j", "wall", "v0", "Q", "model")}
+    from pyhost.output import read_collisions
+
+    cols = read_collisions(run_dir)
     totals = heat_by_model_offline(load_scene(run_dir.parent / "case.toml"), cols, models)
-    return dict(totals, _collisions=len(rows))
+    return dict(totals, _collisions=len(cols["i"]))
+
+
+def has_collisions(run_dir: Path) -> bool:
+    """The run folder holds a collision log, CSV or binary (pyhost.output.read_collisions)."""
+    from pyhost.output import SCHEMA
+
+    return (run_dir / "collisions.csv").is_file() or (run_dir / "collisions" / SCHEMA).is_file()
 
 
 def write_csv(path: Path, columns: dict) -> None:

@@ -120,6 +120,37 @@ def test_bed_killed_and_restarted_from_its_checkpoint_is_exact(bed, tmp_path):
     assert summary(out) == summary(whole)
 
 
+def test_bed_with_binary_collisions_killed_and_restarted_is_the_csv_run(bed, tmp_path):
+    """output.collisions = "binary", SIGKILL at step 6003 (rows after the 4 ms checkpoint on
+    disk), --restart: every column file is cut back to the checkpoint's row count, and the
+    finished log read by read_collisions equals the whole CSV run's values bit for bit; the
+    converter (python -m pyhost collisions OUT --csv) writes the whole run's collisions.csv
+    byte for byte; history and summary equal."""
+    from pyhost.output import read_collisions
+
+    folder, whole = bed
+    toml = folder.parent / "binary" / "case.toml"
+    shutil.copytree(folder, toml.parent)
+    toml.write_text(toml.read_text().replace("\n[output]\n", '\n[output]\ncollisions = "binary"\n'))
+    out = tmp_path / "out"
+    r = pyhost("run", toml.parent, "--test", "--out", out, stop=(6003, "SIGKILL"))
+    assert r.returncode == -9
+    ref = read_collisions(whole)
+    assert len(read_collisions(out)["i"]) > np.count_nonzero(ref["time"] <= 0.004) > 1000
+    r = pyhost("run", toml.parent, "--test", "--out", out, "--restart")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert not (out / "collisions.csv").exists()
+    got = read_collisions(out)
+    assert list(got) == list(ref)
+    for c in ref:
+        assert (got[c].tolist() == ref[c].tolist()) if c == "model" else got[c].tobytes() == ref[c].tobytes(), c
+    r = pyhost("collisions", out, "--csv")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert (out / "collisions.csv").read_bytes() == (whole / "collisions.csv").read_bytes()
+    assert (out / "history.csv").read_bytes() == (whole / "history.csv").read_bytes()
+    assert summary(out) == summary(whole)
+
+
 def test_bed_stopped_by_sigterm_and_restarted_equals_to_its_chaos_level(bed, tmp_path):
     """SIGTERM at step 6003 checkpoints at step 6010, a step the whole run did not checkpoint:
     the restart rebuilds LIGGGHTS' neighbour lists and periodic images there, a change in the

@@ -68,6 +68,22 @@ def test_tracker_reports_opened_and_closed():
         tr.update(np.array([a, a]))
 
 
+def test_tracker_match_gives_each_contacts_place_in_the_last_sample():
+    """match(): for every key its index in the last open_keys (-1: new), and the indices of
+    the closed ones there, so per-contact arrays can follow the keys; against a dict."""
+    rng = np.random.default_rng(5)
+    tr, last = ContactTracker(), np.empty(0, np.int64)
+    for _ in range(20):
+        keys = rng.permutation(np.unique(rng.integers(0, 60, 40)))[:30].astype(np.int64)
+        opened, closed, prev = tr.match(keys)
+        where = {k: n for n, k in enumerate(last.tolist())}
+        assert prev.tolist() == [where.get(k, -1) for k in keys.tolist()]
+        assert opened.tolist() == [n for n, k in enumerate(keys.tolist()) if k not in where]
+        assert last[closed].tolist() == [k for k in last.tolist() if k not in set(keys.tolist())]
+        assert tr.open_keys.tolist() == keys.tolist()
+        last = keys
+
+
 def test_heat_exchange_conserves_and_caps():
     rng = np.random.default_rng(3)
     T = rng.uniform(300, 400, 50)
