@@ -116,6 +116,13 @@ def input_lines(scene: Scene, data_file: Path, skin: float | None = None) -> lis
     ]
     if any(m.dem.youngs_modulus > 1e9 for m in mats):
         lines.append("hard_particles yes")
+    if g_mag > 0:
+        # Under mpirun: cut the domain across the widest horizontal axis, not along gravity
+        # (LIGGGHTS' default for a tall box), where the settled bed would sit on one rank.
+        up = int(np.argmax(np.abs(g)))
+        extent = np.subtract(scene.domain.box[1::2], scene.domain.box[0::2])
+        across = max((a for a in range(3) if a != up), key=lambda a: extent[a])
+        lines.append("processors " + " ".join("*" if a == across else "1" for a in range(3)))
     lines += [
         f"read_data {data_file}",
         f"neighbor {num(skin)} bin", "neigh_modify delay 0",

@@ -183,8 +183,9 @@ class Fluid:
     temperature: float = spec(">0", 293.15, "initial gas temperature [K] (with effects.convection)")
     inlet_temperature: float = spec(">=0", 0.0, "gas temperature at the inlet [K]; 0: the initial temperature")
     ranks: int = spec(">0", 1, "MPI ranks of the fluid solver, started as a job of its own (mpirun -np, "
-                               "after decomposePar; the box mesh is split along x, a user's case needs its own "
-                               "system/decomposeParDict with that many subdomains)")
+                               "after decomposePar; the box mesh is cut into slabs across x or y, whichever has "
+                               "more cells; a user's case needs its own system/decomposeParDict with that many "
+                               "subdomains)")
 
     @property
     def prandtl(self) -> float:

@@ -120,9 +120,9 @@ def check_scene(scene) -> None:
             if ranks > 1 and not decompose.is_file():
                 raise SceneError(f"{file}: fluid.ranks = {ranks}: the user's case has no {decompose}, which "
                                  "decomposePar needs")
-        elif ranks > scene.fluid.cells[0]:
-            raise SceneError(f"{file}: fluid.ranks = {ranks}: the box mesh is split along x into one slab per rank, "
-                             f"and fluid.cells has only {scene.fluid.cells[0]} cells in x")
+        elif ranks > max(scene.fluid.cells[:2]):
+            raise SceneError(f"{file}: fluid.ranks = {ranks}: the box mesh is cut into one slab per rank across x or y, "
+                             f"and fluid.cells has only {max(scene.fluid.cells[:2])} cells there")
     if scene.scripted:          # the script places the particles and sets the box and the step
         return
     for k, w in enumerate(scene.walls):

@@ -143,7 +143,7 @@ SCENES = {   # id: (change, words the one-line message must hold)
     "inlet table and velocity": (fluid(inlet_table=[[0.0, 0.1]], inlet_velocity=1.0), ["fluid.inlet_table"]),
     "unknown drag law": (fluid(drag="stokes"), ["fluid.drag"]),
     "fluid ranks zero": (fluid(ranks=0), ["fluid.ranks"]),
-    "fluid ranks above the cells in x": (fluid(cells=[4, 1, 8], ranks=5), ["fluid.ranks = 5", "only 4 cells in x"]),
+    "fluid ranks above the cells across": (fluid(cells=[4, 1, 8], ranks=5), ["fluid.ranks = 5", "only 4 cells there"]),
     "missing time": (remove(("time",)), ["time", "missing"]),
     "sample_every zero": (setter(("time", "sample_every"), 0), ["time.sample_every"]),
     "wall temperature negative": (setter(("walls",), [dict(plane="zlo", material="steel", temperature=-1.0)]),
