@@ -595,7 +595,11 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             except Exception as err:      # the stop goes on: summary, engines closed, exit 128 + n
                 log(f"warning: no checkpoint at the stop ({type(err).__name__}: {err}); the last one stays")
         if coupling is not None:
-            coupling.finish(status=f"stopped at t = {coupling.t:g} s by {type(exc).__name__}: {exc}")
+            try:
+                coupling.finish(status=f"stopped at t = {coupling.t:g} s by {type(exc).__name__}: {exc}")
+            except Exception as err:      # the error that stopped the run is the one to report
+                log(f"warning: no summary.json ({type(err).__name__}: {err}); collisions.csv and history.csv "
+                    "hold the run so far")
         raise
     if coupling is None:
         raise ScriptError(f"{scene.path}: the script has no 'run' command: nothing to simulate")

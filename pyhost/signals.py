@@ -45,7 +45,7 @@ def deferred(on: bool = True):
     end): the coupling loop stops at the end of a step, where its state is consistent and a
     checkpoint can be written (pyhost.checkpoint)."""
     before = _deferred[0]
-    _deferred[0] = on
+    _deferred[0] = on or before          # inside a deferring block, deferral stays
     try:
         yield
     finally:

@@ -199,12 +199,23 @@ def run(args) -> int:
     comm = world()
     if comm is not None and comm.Get_rank() != 0:
         return Follower(comm).serve()
-    link = Link(comm) if comm is not None else None
+    if comm is None:
+        return run_case(args, None)
+    from pyhost import signals
+    from pyhost.exitcodes import classify
+
+    link = Link(comm)
     try:
-        return run_case(args, link)
+        with signals.deferred():        # a signal stops rank 0 between collective calls, never inside one
+            return run_case(args, link)
+    except BaseException as exc:
+        if link.broken:                 # the followers may wait in another call: end them all
+            code, message = classify(exc)
+            print(f"error: {message}", file=sys.stderr)
+            link.abort(code)
+        raise
     finally:
-        if link is not None:
-            link.close()
+        link.close()
 
 
 def run_case(args, link) -> int:

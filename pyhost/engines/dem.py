@@ -27,7 +27,7 @@ import numpy as np
 
 from pyhost.collisions import WALL_BASE
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
-from pyhost.engines.ranks import local_atoms, local_values, put_by_id, write_local
+from pyhost.engines.ranks import collective, gather_arrays, local_atoms, local_values, put_by_id, write_local
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 
 FLUID_FIX = "collheat_fluid"
@@ -103,6 +103,7 @@ class Dem:
             self._commit()
             self.link.order(name, *args)
 
+    @collective
     def _raw(self, line: str) -> None:
         self._order("command", line)
         self.lmp.command(line)
@@ -122,6 +123,7 @@ class Dem:
             raise LiggghtsError(f"{cmd.where()}: {exc}") from None
         self.info.learn(cmd)
 
+    @collective
     def steps(self, steps: str, upto: bool) -> int:
         """The number of steps of a ``run`` (a number or a $variable, evaluated by LIGGGHTS)."""
         try:
@@ -163,11 +165,13 @@ class Dem:
             self._raw("run 0")                                                              # and set up again
         return added
 
+    @collective
     def run(self, steps: int) -> None:
         self._order("run", int(steps))
         self.lmp.run(int(steps))
         self._pending = None            # the gathered atoms are out of date
 
+    @collective
     def count(self) -> int:
         """Number of particles on all ranks now."""
         if self.link is None:
@@ -191,6 +195,7 @@ class Dem:
         return lo, hi, np.array(self.info.periodic)
 
     # -- particles --------------------------------------------------------------------
+    @collective
     def atoms(self, temperature: bool = True) -> Atoms:
         lmp = self.lmp
         if self.link is None:
@@ -200,9 +205,8 @@ class Dem:
         if self._pending is not None and (not temperature or self._pending[0].T is not None):
             return self._pending[0]     # no run or command since: as serially, the same arrays
         self._order("atoms", temperature)
-        parts = self.link.gather(local_atoms(lmp, temperature))
-        self._counts = np.array([len(p[0]) for p in parts])
-        cols = [np.concatenate([p[k] for p in parts]) for k in range(len(parts[0]))]
+        cols, counts = gather_arrays(self.link.comm, local_atoms(lmp, temperature))
+        self._counts = np.array(counts)
         atoms = Atoms(cols[0].astype(np.int64), *cols[1:6], cols[6] if temperature else None)
         self._pending = (atoms, None if atoms.T is None else atoms.T.copy(), atoms.v.copy())
         return atoms
@@ -220,6 +224,7 @@ class Dem:
             self._pending = (atoms, None if T0 is None else atoms.T.copy(), atoms.v.copy())
             self._write(T=T, v=v)
 
+    @collective
     def _write(self, **arrays) -> None:
         """Each rank's slice (the local order of the last gather) of per-atom arrays."""
         cut = np.cumsum(self._counts)[:-1]
@@ -229,6 +234,7 @@ class Dem:
         self.link.order("write", FLUID_FIX)
         write_local(self.lmp, *self.link.scatter(list(zip(*pieces))), force_fix=FLUID_FIX)
 
+    @collective
     def per_atom(self, names) -> tuple:
         """Copies of per-atom arrays (``Liggghts.atom`` names, e.g. id, f, torque) of all atoms,
         in the order of ``atoms()``."""
@@ -238,6 +244,7 @@ class Dem:
         parts = self.link.gather(local_values(self.lmp, names))
         return tuple(np.concatenate([p[k] for p in parts]) for k in range(len(names)))
 
+    @collective
     def put_per_atom(self, ids, **arrays) -> None:
         """Per-atom arrays given for all atoms by id (e.g. f=..., torque=...) into LIGGGHTS."""
         self._order("put", ids, arrays)
@@ -252,6 +259,7 @@ class Dem:
         v = self.lmp.atom("v") if self.link is None else self._pending[0].v
         np.add.at(v, np.asarray(local_index), dv)
 
+    @collective
     def set_force(self, force) -> None:
         """Force [N] on each atom (the order of the last ``atoms()``), applied every step
         until changed."""
@@ -300,13 +308,14 @@ class Dem:
             parts.append(self._mesh_contacts(atoms, np.array(codes, np.int64)))
         return _concat(parts)
 
+    @collective
     def _local(self, which: str):
         compute_id, keywords = getattr(self.info, which)
         if self.link is None:
             a = self.lmp.local_array(compute_id)
         else:
             self._order("local", compute_id)
-            a = np.concatenate(self.link.gather(self.lmp.local_array(compute_id)))
+            a = gather_arrays(self.link.comm, [self.lmp.local_array(compute_id)])[0][0]
         cols_attr = "pair_cols" if which == "pair_compute" else "wall_cols"
         if getattr(self, cols_attr) is None:
             setattr(self, cols_attr, local_columns(keywords, a.shape[1]))

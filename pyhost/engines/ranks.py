@@ -39,10 +39,39 @@ def world():
 
 def local_atoms(lmp, temperature: bool) -> tuple:
     """This rank's atoms as copies: id, x, v, radius, rmass, type (and Temp)."""
-    parts = [lmp.atom(name).copy() for name in ("id", "x", "v", "radius", "rmass", "type")]
+    parts = [_plain(lmp.atom(name)) for name in ("id", "x", "v", "radius", "rmass", "type")]
     if temperature:
-        parts.append(lmp.temperature().copy() if lmp.nlocal else np.zeros(0))
+        parts.append(_plain(lmp.temperature()) if lmp.nlocal else np.zeros(0))
     return tuple(parts)
+
+
+def _plain(a) -> np.ndarray:
+    """A contiguous array whose buffer mpi4py knows: numpy's own format ('i', 'd'), not the
+    explicit little-endian one ('<i', '<d') that arrays made from ctypes memory keep, copies
+    included."""
+    if memoryview(a).format == a.dtype.char and a.flags.c_contiguous:
+        return a
+    out = np.empty(a.shape, np.dtype(a.dtype.char))     # numpy's builtin dtype (np.array keeps ctypes')
+    out[...] = a
+    return out
+
+
+def gather_arrays(comm, arrays) -> tuple:
+    """Every rank's arrays (the same number, dtypes and trailing shapes on all ranks), joined
+    in rank order on rank 0 through MPI's typed ``Gatherv`` (one copy, no pickling); returns
+    (arrays, rows per rank) on rank 0, (None, None) elsewhere. Collective."""
+    arrays = [_plain(a) for a in arrays]
+    counts = comm.gather(len(arrays[0]) if arrays else 0, root=ROOT)
+    joined = []
+    for a in arrays:
+        if comm.Get_rank() != ROOT:
+            comm.Gatherv(a, None, root=ROOT)
+            continue
+        width = int(np.prod(a.shape[1:], dtype=np.int64))
+        whole = np.empty((sum(counts),) + a.shape[1:], a.dtype)
+        comm.Gatherv(a, [whole, [c * width for c in counts]], root=ROOT)
+        joined.append(whole)
+    return (tuple(joined), counts) if comm.Get_rank() == ROOT else (None, None)
 
 
 def local_values(lmp, names) -> tuple:
@@ -80,10 +109,13 @@ class Link:
         self.comm = comm
         self.size = comm.Get_size()
         self.closed = False
+        self.broken = False     # an error inside a collective call: the followers may wait in another one
 
     def order(self, name: str, *args) -> None:
         if self.closed:
             raise RuntimeError(f"MPI order '{name}' after the other ranks were released")
+        if self.broken:
+            raise RuntimeError(f"MPI order '{name}': the ranks are out of step after an error inside a collective call")
         self.comm.Ibarrier().Wait()        # the followers wait in theirs (see Follower.next)
         self.comm.bcast((name, args), root=ROOT)
 
@@ -95,9 +127,34 @@ class Link:
 
     def close(self) -> None:
         """The followers end (they close their LIGGGHTS if one is open); once."""
-        if not self.closed:
+        if not self.closed and not self.broken:
             self.order("close")
             self.closed = True
+
+    def abort(self, code: int) -> None:
+        """End every rank (MPI_Abort): after an error inside a collective call, the followers
+        cannot be released in order. mpirun exits with ``code``."""
+        import sys
+        sys.stdout.flush()
+        sys.stderr.flush()
+        self.comm.Abort(code)
+
+
+def collective(method):
+    """A method of rank 0 that makes collective calls: an error inside it leaves the
+    followers possibly waiting in another call, so the link is marked broken (the run then
+    ends through MPI_Abort, pyhost.commands.run)."""
+    import functools
+
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        try:
+            return method(self, *args, **kwargs)
+        except BaseException:
+            if self.link is not None:
+                self.link.broken = True
+            raise
+    return wrapper
 
 
 class Follower:
@@ -144,13 +201,13 @@ class Follower:
         self.lmp.variable(name)
 
     def do_atoms(self, temperature) -> None:
-        self.comm.gather(local_atoms(self.lmp, temperature), root=ROOT)
+        gather_arrays(self.comm, local_atoms(self.lmp, temperature))
 
     def do_count(self) -> None:
         self.comm.gather(self.lmp.nlocal, root=ROOT)
 
     def do_local(self, compute_id) -> None:
-        self.comm.gather(self.lmp.local_array(compute_id), root=ROOT)
+        gather_arrays(self.comm, [self.lmp.local_array(compute_id)])
 
     def do_per_atom(self, names) -> None:
         self.comm.gather(local_values(self.lmp, names), root=ROOT)

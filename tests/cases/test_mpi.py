@@ -115,3 +115,31 @@ def test_bad_scene_under_mpirun_exits_2_without_hanging(tmp_path):
                         str(tmp_path / "missing")], capture_output=True, text=True, env=ENV, timeout=120)
     assert r.returncode == 2
     assert "missing/case.toml: no such scene file" in r.stderr
+
+
+BREAKER = """
+import sys
+import pyhost.engines.dem as dem
+from pyhost.cli import main
+from mpi4py import MPI
+if MPI.COMM_WORLD.Get_rank() == 0:
+    calls, real = [0], dem.gather_arrays
+    def gather_arrays(comm, arrays):
+        calls[0] += 1
+        if calls[0] == 20:          # the other rank is already inside this collective call
+            raise RuntimeError("injected fault inside a collective call")
+        return real(comm, arrays)
+    dem.gather_arrays = gather_arrays
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_error_inside_a_collective_call_ends_every_rank(tmp_path):
+    """An error on rank 0 while the other rank waits inside a collective call cannot be
+    unwound in order: the job ends through MPI_Abort with the error's message and exit code,
+    never hangs."""
+    r = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", sys.executable, "-c", BREAKER, "run",
+                        str(CASES / "hot-cold-box"), "--test", "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True, env=ENV, timeout=300)
+    assert r.returncode == 1
+    assert "injected fault inside a collective call" in r.stderr
