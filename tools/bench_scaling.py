@@ -99,7 +99,7 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
         base = load_scene(Path(os.environ["BENCH_CASE"]).resolve() / "case.toml")
         scene = variant(base, sim_time, contact_heat=heat)
         if scene.fluid is not None:     # the fluid on as many ranks as LIGGGHTS
-            scene = dataclasses.replace(scene, fluid=dataclasses.replace(scene.fluid, ranks=len(ranks_of(comm))))
+            scene = dataclasses.replace(scene, fluid=dataclasses.replace(scene.fluid, ranks=comm.Get_size() if comm is not None else 1))
     timed = {}
 
     def wrap(dem):
@@ -125,10 +125,6 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
                           in_fluid=timed["fluid"].inside if "fluid" in timed else 0.0,
                           collisions=summary["collisions"], rss_max_mb=max(rss) / 1024, rss_sum_mb=sum(rss) / 1024,
                           balance=summary.get("energy_balance_error"))))
-
-
-def ranks_of(comm) -> range:
-    return range(comm.Get_size() if comm is not None else 1)
 
 
 def measure(n: int, ranks: int, sim_time: float, heat: str, tmp: Path, case: Path | None = None) -> dict:

@@ -161,8 +161,8 @@ class Dem:
                                       "the host needs: add them (LIGGGHTS allows one such compute)")
         self.run(0)
         if fluid_force:         # the set-up added fix external's array while it was uninitialised
-            self.set_force(np.zeros((self.count() if self.link else self.lmp.nlocal, 3)))  # memory: zero it
-            self._raw("run 0")                                                              # and set up again
+            self.set_force(np.zeros((self.count(), 3)))     # memory: zero it and set up again
+            self._raw("run 0")
         return added
 
     @collective
