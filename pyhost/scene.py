@@ -434,6 +434,8 @@ def _user_fluid_case(fluid, path, file, energy: bool):
         missing.append("constant/polyMesh or system/blockMeshDict")
     if missing:
         raise SceneError(f"{file}: fluid.case: {folder} lacks what collheatFoam needs: {', '.join(missing)}")
+    from pyhost.engines.foam_case_check import check_case
+    check_case(folder, file, fluid.ranks, energy)
     default = Fluid()
     for key in ("density", "viscosity", "inlet_velocity", "inlet_table", "plenum", "cells", "sides",
                 "temperature", "inlet_temperature"):

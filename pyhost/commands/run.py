@@ -40,17 +40,21 @@ def start_fluid(scene, folder: Path):
     from foamlib import FoamFile
 
     from pyhost.engines.fluid_case import box_case
+    from pyhost.engines.foam_case_check import density
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
     energy = scene.effects.convection != "none"
     if f.case:                          # the user's own case, copied: the host never writes into it
+        source = (scene.folder / f.case).resolve()
         shutil.rmtree(folder, ignore_errors=True)
-        shutil.copytree(scene.folder / f.case, folder, symlinks=True,
-                        ignore=shutil.ignore_patterns("processor*", ".link", "log.*", "[1-9]*", "0.[0-9]*"))
+        shutil.copytree(source, folder, symlinks=True, ignore=_case_ignore(source, folder))
+        props = FoamFile(folder / "constant" / "transportProperties")
+        if "rho" not in props:          # kept in 0/rho (CFDEM cases); collheatFoam reads it here
+            props["rho"] = density(source, str(scene.path))
         if energy:                      # the gas's properties are the scene's, given once
-            FoamFile(folder / "constant" / "transportProperties").update({"Cp": f.heat_capacity,
-                                                                           "kappa": f.conductivity})
+            props.update({"Cp": f.heat_capacity, "kappa": f.conductivity})
+        _mesh(folder, source, str(scene.path))
         return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
@@ -65,6 +69,45 @@ def start_fluid(scene, folder: Path):
                     T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
                     T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
     return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
+
+
+def _case_ignore(source: Path, copy: Path):
+    """What a copy of the user's case leaves out: the copy itself and any run's output
+    (a folder holding scene.json) when the case folder holds them (``case = "."``), time
+    folders other than 0, processor folders, logs and the solver's pipes."""
+    def ignore(where, names):
+        where = Path(where)
+        left = {n for n in names if n.startswith(("processor", "log.")) or n == ".link"
+                or copy.is_relative_to((where / n).resolve()) or (where / n / "scene.json").is_file()}
+        if where.resolve() == source:
+            left |= {n for n in names if _time_folder(n) and (where / n).is_dir()}
+        return left
+    return ignore
+
+
+def _time_folder(name: str) -> bool:
+    try:
+        return float(name) != 0
+    except ValueError:
+        return False
+
+
+def _mesh(case: Path, source: Path, file: str) -> None:
+    """blockMesh on the copied case unless it has a mesh: a blockMeshDict that blockMesh
+    refuses is bad input (SceneError) with blockMesh's own words."""
+    from pyhost.engines.openfoam import FluidError, run_utility
+    from pyhost.scene import SceneError
+
+    if (case / "constant" / "polyMesh" / "owner").is_file():
+        return
+    try:
+        run_utility(case, "blockMesh")
+    except FluidError:
+        log = (case / "log.blockMesh").read_text(errors="replace").splitlines()
+        fatal = next((k for k, line in enumerate(log) if "FOAM FATAL" in line), len(log) - 6)
+        words = "; ".join(line.strip() for line in log[fatal + 1:fatal + 6] if line.strip())
+        raise SceneError(f"{file}: fluid.case: {source / 'system/blockMeshDict'}: blockMesh refuses it: "
+                         f"{words}") from None
 
 
 def box_world(scene, out: Path, start=None, restart: Path | None = None):

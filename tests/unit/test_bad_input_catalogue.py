@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import tomli_w
 
@@ -187,6 +188,133 @@ def test_bad_scene_is_refused_before_any_engine(name, tmp_path, capsys, no_engin
     assert code == 2, err
     assert_one_line(err, [str(case / "case.toml"), *words])
     assert not (tmp_path / "out" / "summary.json").exists() and not (tmp_path / "out" / "dem").exists()
+
+
+def user_fluid_case(folder: Path, ranks: int = 1) -> Path:
+    """A user's OpenFOAM case of our own writing: a 1 cm box of 2 x 1 x 4 cells, faces named
+    xlo .. zhi, gas in at zlo; rho in 0/rho (as CFDEM cases keep it), not in transportProperties."""
+    from foamlib import FoamFile
+
+    from pyhost.engines.fluid_case import box_case
+    faces = dict(xlo="wall", xhi="wall", ylo="slip", yhi="slip", zlo=("inlet", (0.0, 0.0, 0.1)), zhi="outlet")
+    box_case(folder, lo=(0, 0, 0), hi=(0.01, 0.005, 0.02), cells=(2, 1, 4), boundaries=faces, rho=1.2,
+             nu=1.5e-5, nprocs=ranks)
+    del FoamFile(folder / "constant" / "transportProperties")["rho"]
+    (folder / "0" / "rho").write_text("FoamFile { version 2.0; format ascii; class volScalarField; object rho; }\n"
+                                      "dimensions [1 -3 0 0 0 0 0];\ninternalField uniform 1.2;\n"
+                                      'boundaryField { ".*" { type zeroGradient; } }\n')
+    return folder
+
+
+def foam_edit(rel, key, value=None):
+    """A change of the user's case: set (or with None delete) a key of one of its files."""
+    def change(case):
+        from foamlib import FoamFile
+        f = FoamFile(case / "fluid" / rel)
+        if value is None:
+            del f[key]
+        else:
+            f[key] = value
+    return change
+
+
+def foam_rename(rel, old, new):
+    """Rename a patch's entry of a field's boundaryField."""
+    def change(case):
+        from foamlib import FoamFile
+        f = FoamFile(case / "fluid" / rel)
+        f["boundaryField", new] = f["boundaryField", old]
+        del f["boundaryField", old]
+    return change
+
+
+def foam_text(rel, text):
+    def change(case):
+        path = case / "fluid" / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.unlink() if text is None else path.write_text(text)
+    return change
+
+
+def foam_scene(**fluid_keys):
+    def change(case):
+        scene = copy.deepcopy(BASE)
+        scene["effects"]["fluid"] = True
+        scene["fluid"] = dict(case="fluid", **fluid_keys)
+        (case / "case.toml").write_text(tomli_w.dumps(scene))
+    return change
+
+
+BLOCKS = ("FoamFile { version 2.0; format ascii; class dictionary; object blockMeshDict; }\n"
+          "vertices ((0 0 0) (1 0 0) (1 1 0) (0 1 0) (0 0 1) (1 0 1) (1 1 1) (0 1 1));\n"
+          "blocks (hex (0 1 2 3 4 5 6 VERTEX) (1 1 1) simpleGrading (1 1 1));\n"
+          "patches (wall xlo ((0 4 7 3)) wall xhi ((1 2 6 5)) wall ylo ((0 1 5 4)) wall yhi ((3 7 6 2))"
+          " patch zlo ((0 3 2 1)) patch zhi ((4 5 6 7)));\n")
+POLYMESH = ("FoamFile { version 2.0; format ascii; class polyBoundaryMesh; object boundary; }\n6 (\n"
+            + "".join(f"{n} {{ type wall; inGroups List<word> 1(wall); nFaces 1; startFace {k}; }}\n"
+                      for k, n in enumerate(("xlo", "xhi", "ylo", "yhi", "bottom", "zhi"))) + ")\n")
+FLUID_CASES = {   # id: (changes of the valid user case, words the one-line message must hold)
+    "rho nowhere": ([foam_text("0/rho", None)], ["transportProperties: rho: missing, and no 0/rho"]),
+    "0/rho not uniform": ([foam_edit("0/rho", "internalField", np.full(8, 1.2))],
+                          ["0/rho: internalField: must be uniform"]),
+    "0/rho negative": ([foam_edit("0/rho", "internalField", -1.0)], ["0/rho: internalField", "positive"]),
+    "rho a word": ([foam_edit("constant/transportProperties", "rho", "air")], ["transportProperties: rho", "'air'"]),
+    "nu missing": ([foam_edit("constant/transportProperties", "nu")], ["transportProperties: nu: missing"]),
+    "0/U patch misnamed": ([foam_rename("0/U", "zhi", "top")],
+                           ["0/U: boundaryField", "patch 'zhi'", "system/blockMeshDict", "instead of 'top'"]),
+    "0/p patch missing": ([foam_edit("0/p", ("boundaryField", "xlo"))], ["0/p: boundaryField", "patch 'xlo'"]),
+    "0/p regex not matching": ([foam_edit("0/p", ("boundaryField", "xlo")), foam_edit("0/p", ("boundaryField", "xhi")),
+                                foam_edit("0/p", ("boundaryField", '"x(l|h)i"'), {"type": "zeroGradient"})],
+                               ["0/p: boundaryField", "patch 'xlo'"]),
+    "polyMesh patch without entry": ([foam_text("constant/polyMesh/owner", ""),
+                                      foam_text("constant/polyMesh/boundary", POLYMESH)],
+                                     ["0/U: boundaryField", "patch 'bottom'", "constant/polyMesh/boundary"]),
+    "blockMeshDict not OpenFOAM": ([foam_text("system/blockMeshDict", BLOCKS.replace("(0 1 1));", "(0 1 1);"))],
+                                   ["system/blockMeshDict: not a valid OpenFOAM file", "line 2, column 10"]),
+    "block names a missing vertex": ([foam_text("system/blockMeshDict", BLOCKS.replace("VERTEX", "8"))],
+                                     ["system/blockMeshDict: blocks", "from 0 to 7"]),
+    "blockMeshDict without blocks": ([foam_edit("system/blockMeshDict", "blocks")], ["blockMeshDict: blocks: missing"]),
+    "subdomains differ from ranks": ([foam_scene(ranks=2)],
+                                     ["decomposeParDict: numberOfSubdomains: 1, but fluid.ranks = 2"]),
+    "simple split differs from ranks": ([foam_scene(ranks=2), foam_edit("system/decomposeParDict",
+                                                                         "numberOfSubdomains", 2)],
+                                        ["decomposeParDict: simpleCoeffs.n: [1, 1, 1] makes 1"]),
+}
+
+
+def fluid_case_with(changes, tmp_path):
+    case = tmp_path / "case"
+    case.mkdir()
+    user_fluid_case(case / "fluid")
+    foam_scene()(case)
+    for change in changes:
+        change(case)
+    return case
+
+
+@pytest.mark.parametrize("name", FLUID_CASES)
+def test_bad_user_fluid_case_is_refused_before_any_engine(name, tmp_path, capsys, no_engine):
+    """Mistakes in a user's OpenFOAM case that collheatFoam would only find at its start."""
+    changes, words = FLUID_CASES[name]
+    case = fluid_case_with(changes, tmp_path)
+    code, err = run_main(["run", case, "--out", tmp_path / "out"], capsys)
+    assert code == 2, err
+    assert_one_line(err, [str(case / "case.toml"), "fluid.case", *words])
+    assert not (tmp_path / "out" / "summary.json").exists()
+
+
+@pytest.mark.parametrize("changes", [[], [foam_scene(ranks=2), foam_edit("system/decomposeParDict",
+                                                                           "numberOfSubdomains", 2),
+                                          foam_edit("system/decomposeParDict", ("coeffs", "n"), [2, 1, 1])],
+                                     [foam_text("system/blockMeshDict", BLOCKS.replace("VERTEX", "7"))],
+                                     [foam_edit("0/p", "boundaryField", {'".*"': {"type": "zeroGradient"}}),
+                                      foam_edit("0/U", "boundaryField", {"wall": {"type": "noSlip"},
+                                                                         '"(y.*|z.*)"': {"type": "slip"}})]],
+                         ids=["0/rho", "two ranks", "old-style patches", "regex and group entries"])
+def test_valid_user_fluid_case_is_accepted(changes, tmp_path):
+    """The catalogue's valid user case (rho in 0/rho) and valid variants pass the checks."""
+    from pyhost.scene import load_scene
+    assert load_scene(fluid_case_with(changes, tmp_path) / "case.toml").fluid.case == "fluid"
 
 
 def base_case(tmp_path):

@@ -1,0 +1,177 @@
+"""Checks of a user's OpenFOAM case (``[fluid] case``) before any engine starts, so that a
+mistake in it is bad input (exit 2) naming the file, the key and what to write, not a
+solver that dies at its first step (exit 3).
+
+``check_case(folder, file, ranks, energy)`` reads with foamlib: every file it needs parses;
+the gas density ``rho`` (kg/m^3) in constant/transportProperties or, as CFDEM cases keep it,
+the uniform internalField of 0/rho; ``nu``; the mesh's patches (constant/polyMesh/boundary,
+else system/blockMeshDict's ``boundary`` or old-style ``patches``) each with an entry in 0/U
+and 0/p (0/T with the gas energy) by name, group or quoted regular expression; blocks and
+faces naming existing vertices; with ``ranks`` > 1, system/decomposeParDict cutting the mesh
+into that many subdomains. ``density(folder, file)`` is the gas density.
+"""
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+from foamlib import FoamFile
+
+from pyhost.scene import SceneError
+
+#: patch types OpenFOAM also puts in a group of that name (#includeEtc setConstraintTypes
+#: gives each of these its field entry)
+GROUPED_TYPES = {"wall", "empty", "wedge", "symmetry", "symmetryPlane", "cyclic", "cyclicAMI",
+                 "cyclicACMI", "cyclicSlip", "processor", "processorCyclic", "nonuniformTransformCyclic"}
+
+
+def _read(folder: Path, rel: str, file: str) -> dict:
+    """The whole file parsed; SceneError naming it and the line foamlib stopped at."""
+    try:
+        return FoamFile(folder / rel).as_dict()
+    except ValueError as exc:       # foamlib's FoamFileDecodeError
+        raise SceneError(f"{file}: fluid.case: {folder / rel}: not a valid OpenFOAM file: "
+                         f"{str(exc).splitlines()[0].rstrip(':')}") from None
+
+
+def _number(entry) -> float | None:
+    value = getattr(entry, "value", entry)
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
+def density(folder: Path, file: str) -> float:
+    """``rho`` (kg/m^3) from constant/transportProperties, else from the uniform
+    internalField of 0/rho."""
+    props = _read(folder, "constant/transportProperties", file)
+    where = f"{file}: fluid.case: {folder / 'constant/transportProperties'}"
+    if "rho" in props:
+        rho, source = _number(props["rho"]), f"{where}: rho"
+    elif (folder / "0" / "rho").is_file():
+        rho, source = _number(_read(folder, "0/rho", file).get("internalField")), \
+            f"{file}: fluid.case: {folder / '0/rho'}: internalField"
+        if rho is None:
+            raise SceneError(f"{source}: must be uniform (one density for the gas), e.g. 'internalField uniform 1.2;' "
+                             f"or 'rho 1.2;' in constant/transportProperties")
+    else:
+        raise SceneError(f"{where}: rho: missing, and no 0/rho: write the gas density, e.g. 'rho 1.2;' (kg/m^3)")
+    if rho is None or not (math.isfinite(rho) and rho > 0):
+        raise SceneError(f"{source}: must be a positive density in kg/m^3, got {props.get('rho', rho)!r}")
+    return rho
+
+
+def mesh_patches(folder: Path, file: str) -> tuple[str, dict]:
+    """The mesh's file and its patches {name: groups (its type, inGroups)}."""
+    if (folder / "constant" / "polyMesh" / "owner").is_file():
+        rel = "constant/polyMesh/boundary"
+        if not (folder / rel).is_file():
+            raise SceneError(f"{file}: fluid.case: {folder / rel}: missing beside constant/polyMesh/owner")
+        entries = _read(folder, rel, file).get(None)
+        if not isinstance(entries, list) or not all(isinstance(e, tuple) and len(e) == 2 for e in entries):
+            raise SceneError(f"{file}: fluid.case: {folder / rel}: not a list of patches 'name {{ type ...; }}'")
+        return rel, {name: _groups(d) for name, d in entries}
+    rel = "system/blockMeshDict"
+    mesh = _read(folder, rel, file)
+    where = f"{file}: fluid.case: {folder / rel}"
+    for key in ("vertices", "blocks"):
+        if not isinstance(mesh.get(key), list) or not mesh[key]:
+            raise SceneError(f"{where}: {key}: missing or empty")
+    vertices = len(mesh["vertices"])
+    patches, faces = {}, []
+    if isinstance(mesh.get("boundary"), list):
+        for item in mesh["boundary"]:
+            if not (isinstance(item, tuple) and len(item) == 2 and isinstance(item[1], dict)):
+                raise SceneError(f"{where}: boundary: each entry must be 'name {{ type patch; faces (...); }}', "
+                                 f"got {item!r}")
+            patches[item[0]] = _groups(item[1])
+            faces += item[1].get("faces", [])
+    elif isinstance(mesh.get("patches"), list):   # old style: type name (faces) ...
+        flat = mesh["patches"]
+        for k in range(0, len(flat) - 2, 3):
+            patches[flat[k + 1]] = _groups({"type": flat[k]})
+            faces += flat[k + 2] if isinstance(flat[k + 2], list) else []
+    blocks = mesh["blocks"]
+    hexes = [blocks[k + 1] for k in range(len(blocks) - 1) if blocks[k] == "hex"]
+    if not hexes:
+        raise SceneError(f"{where}: blocks: no 'hex (8 vertices) (cells) simpleGrading (...)' block")
+    for what, shapes, n in (("blocks", hexes, 8), ("boundary", faces, 4)):
+        for shape in shapes:
+            ints = isinstance(shape, list) and all(isinstance(i, int) for i in shape)
+            if ints and (len(shape) != n or not all(0 <= i < vertices for i in shape)):
+                raise SceneError(f"{where}: {what}: {shape} must be {n} vertex numbers from 0 to {vertices - 1} "
+                                 f"(there are {vertices} vertices)")
+    return rel, patches
+
+
+def _groups(entry: dict) -> set:
+    groups = entry.get("inGroups", [])
+    groups = groups[1] if isinstance(groups, tuple) else groups     # List<word> 1(wall)
+    return set(groups) | ({entry.get("type")} & GROUPED_TYPES)
+
+
+def _covered(patch: str, groups: set, keys: list) -> bool:
+    if "#includeEtc" in keys and groups & GROUPED_TYPES:
+        return True
+    for key in keys:
+        if key == patch or key in groups:
+            return True
+        if key.startswith('"') and key.endswith('"'):
+            try:
+                if re.fullmatch(key[1:-1], patch) or key[1:-1] in groups:
+                    return True
+            except re.error:
+                return True     # a pattern Python cannot read: left to OpenFOAM
+    return False
+
+
+def check_fields(folder: Path, file: str, fields) -> None:
+    """Each patch of the mesh has its entry in each field's boundaryField."""
+    source, patches = mesh_patches(folder, file)
+    for field in fields:
+        rel = f"0/{field}"
+        entries = _read(folder, rel, file).get("boundaryField")
+        where = f"{file}: fluid.case: {folder / rel}: boundaryField"
+        if not isinstance(entries, dict):
+            raise SceneError(f"{where}: missing or not a dictionary")
+        keys = list(entries)
+        if any(k.startswith("#include") and k != "#includeEtc" for k in keys):
+            continue            # entries from another file: left to OpenFOAM
+        for patch, groups in patches.items():
+            if not _covered(patch, groups, keys):
+                unused = [k for k in keys if k not in patches and not k.startswith(("#", '"'))]
+                raise SceneError(f"{where}: no entry for the mesh's patch {patch!r} (patches of {source}: "
+                                 f"{', '.join(patches)}; entries: {', '.join(keys) or 'none'}): name it "
+                                 f"'{patch} {{ type ...; }}'"
+                                 + (f" (instead of {', '.join(map(repr, unused))}?)" if unused else ""))
+
+
+def check_decomposition(folder: Path, file: str, ranks: int) -> None:
+    """decomposeParDict cuts the mesh into ``ranks`` pieces (for a parallel fluid)."""
+    rel = "system/decomposeParDict"
+    where = f"{file}: fluid.case: {folder / rel}"
+    if not (folder / rel).is_file():
+        raise SceneError(f"{where}: missing; fluid.ranks = {ranks} needs it with numberOfSubdomains {ranks}")
+    d = _read(folder, rel, file)
+    n = d.get("numberOfSubdomains")
+    if n != ranks:
+        raise SceneError(f"{where}: numberOfSubdomains: {n}, but fluid.ranks = {ranks}: write "
+                         f"'numberOfSubdomains {ranks};' there or set fluid.ranks = {n}")
+    method = d.get("method")
+    if method in ("simple", "hierarchical"):
+        coeffs = d.get(f"{method}Coeffs", d.get("coeffs", {}))
+        split = coeffs.get("n") if isinstance(coeffs, dict) else None
+        if isinstance(split, list) and all(isinstance(i, int) for i in split) and math.prod(split) != ranks:
+            raise SceneError(f"{where}: {method}Coeffs.n: {split} makes {math.prod(split)} subdomains, "
+                             f"not numberOfSubdomains {ranks}")
+
+
+def check_case(folder: Path, file: str, ranks: int, energy: bool) -> None:
+    """All the checks of the module doc (the files' presence is checked by the caller)."""
+    density(folder, file)
+    props = _read(folder, "constant/transportProperties", file)
+    if _number(props.get("nu")) is None:
+        raise SceneError(f"{file}: fluid.case: {folder / 'constant/transportProperties'}: nu: missing or not a "
+                         "number: write the kinematic viscosity, e.g. 'nu 1.5e-05;' (m^2/s)")
+    check_fields(folder, file, ("U", "p", "T") if energy else ("U", "p"))
+    if ranks > 1:
+        check_decomposition(folder, file, ranks)
