@@ -41,6 +41,11 @@ class FluidError(RuntimeError):
     """The fluid solver failed; the message ends with the tail of its log."""
 
 
+class FluidCaseError(ValueError):
+    """The solver refused the case's input before its first step (its exit code 2, e.g. a
+    boundary condition it cannot honour): bad input, with the tail of its log."""
+
+
 def _exchange(method):
     """Marks a request/answer exchange: while one is under way the pipes hold half a
     message, so :meth:`FluidSolver.stop` must end the solver instead of asking it to stop."""
@@ -357,7 +362,7 @@ class FluidSolver:
         return self.time
 
     # -- pipes ------------------------------------------------------------------------
-    def _failed(self, what: str, waited: float | None = None) -> FluidError:
+    def _failed(self, what: str, waited: float | None = None) -> FluidError | FluidCaseError:
         """The error for a solver that ended while ``what``, or (``waited`` seconds given)
         one still alive that did not answer in time, which is then ended."""
         if waited is not None and self.proc.poll() is None:
@@ -372,6 +377,9 @@ class FluidSolver:
         except subprocess.TimeoutExpired:
             self._kill()
         rc = self.proc.returncode
+        if rc == 2:
+            return FluidCaseError(f"{self.case.name}: the fluid solver refused the case; end of "
+                                  f"{self.log}:\n{log_tail(self.log)}")
         how = f"exit code {rc}"
         if rc < 0:
             how = f"killed by {signal.Signals(-rc).name}"

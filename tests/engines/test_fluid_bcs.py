@@ -1,0 +1,91 @@
+"""collheatFoam on the pressure conditions users' cases bring (CFDEM tutorials keep
+zeroGradient pressure at walls and fixed-velocity inlets): no gas through a wall, a slip
+wall or an inlet whatever the pressure condition and the direction of gravity; a pressure
+condition the solver cannot honour is refused (exit 2) or stops the run naming the patch
+(exit 3), never a wrong flow that ends well."""
+import numpy as np
+import pytest
+from foamlib import FoamFile
+
+from pyhost.engines.fluid_case import box_case
+from pyhost.engines.openfoam import FluidCaseError, FluidError, FluidSolver
+
+pytestmark = pytest.mark.engines
+
+AIR = dict(rho=1.2, nu=1.5e-5)                      # kg/m^3, m^2/s
+CELL = 0.01                                         # m
+N = (4, 4, 8)                                       # cells per axis
+
+
+def column(tmp_path, *, sides: str, gravity, inlet: float | None, p_sides: dict):
+    """A 4 x 4 x 8 cell column; with ``inlet`` (m/s) gas enters at z lo and leaves at z hi
+    (p fixed 0), else the box is closed. ``p_sides``: 0/p entry of each wall-like patch
+    instead of the fixedFluxPressure the box case writes (the CFDEM way: zeroGradient)."""
+    faces = {f: sides for f in ("xlo", "xhi", "ylo", "yhi")}
+    faces.update(zlo=("inlet", (0.0, 0.0, inlet)) if inlet is not None else sides,
+                 zhi="outlet" if inlet is not None else sides)
+    case = box_case(tmp_path / "fluid", lo=(0, 0, 0), hi=tuple(n * CELL for n in N), cells=N,
+                    boundaries=faces, gravity=gravity, dt=1e-3, **AIR)
+    p = FoamFile(case / "0" / "p")
+    for patch, entry in p_sides.items():
+        p["boundaryField"][patch] = entry
+    return case
+
+
+def run(case, steps: int = 20):
+    with FluidSolver(case) as fluid:
+        fluid.advance(steps * 1e-3, steps)
+        p, u = fluid.fields()
+        return fluid.cell_centres, p, u
+
+
+ZERO_GRADIENT = {"type": "zeroGradient"}
+WALLS = ("xlo", "xhi", "ylo", "yhi")
+
+
+@pytest.mark.parametrize("gravity", [(0, 0, -9.81), (3.0, -4.0, -8.0)])
+def test_closed_box_with_zero_gradient_walls_stays_at_rest(tmp_path, gravity):
+    """A closed box of air at rest under gravity (vertical, and tilted: constant/g in any
+    direction) with zeroGradient pressure on every wall stays at rest, its pressure
+    hydrostatic. Before, gravity drove the gas through the walls (tens of m/s)."""
+    case = column(tmp_path, sides="wall", gravity=gravity, inlet=None,
+                  p_sides={f: ZERO_GRADIENT for f in (*WALLS, "zlo", "zhi")})
+    x, p, u = run(case)
+    print(f"max |U| {np.abs(u).max():.3g} m/s")
+    assert np.abs(u).max() < 1e-6      # m/s: the pressure solver's tolerance; g dt is 0.01 m/s
+    g = np.asarray(gravity, float)
+    hydro = AIR["rho"] * (x @ g)                                     # Pa, up to a constant
+    print(f"pressure off hydrostatic by {np.ptp(p - hydro):.3g} Pa of {np.ptp(hydro):.3g}")
+    assert np.ptp(p - hydro) < 1e-6 * np.ptp(hydro)
+
+
+def test_inlet_with_zero_gradient_pressure_gives_plug_flow(tmp_path):
+    """A column with slip sides, a fixed-velocity inlet at z lo (0.05 m/s) and the outlet at
+    z hi, pressure zeroGradient at the inlet and the sides (the CFDEM way), gravity along
+    -z: a uniform plug at the inlet speed, the pressure hydrostatic. Before, gravity pulled
+    gas out through the inlet."""
+    case = column(tmp_path, sides="slip", gravity=(0, 0, -9.81), inlet=0.05,
+                  p_sides={f: ZERO_GRADIENT for f in (*WALLS, "zlo")})
+    x, p, u = run(case)
+    assert u[:, 2] == pytest.approx(0.05, rel=1e-5)
+    assert np.abs(u[:, :2]).max() < 1e-6
+    slope = np.polyfit(x[:, 2], p, 1)[0]                             # Pa/m along the flow
+    assert slope == pytest.approx(-AIR["rho"] * 9.81, rel=1e-5)
+
+
+def test_fixed_pressure_on_a_wall_is_refused_before_the_first_step(tmp_path):
+    """p fixedValue where U is fixed (a wall) sets the flux twice: refused at start, as bad
+    input (FluidCaseError, exit 2), naming 0/p and the patch."""
+    case = column(tmp_path, sides="wall", gravity=(0, 0, -9.81), inlet=None,
+                  p_sides={"xlo": {"type": "fixedValue", "value": 0.0}})
+    with pytest.raises(FluidCaseError, match=r"0/p, patch 'xlo': p is fixedValue .* write zeroGradient"):
+        run(case)
+
+
+def test_flux_through_a_wall_stops_the_run_naming_the_patch(tmp_path):
+    """A pressure gradient imposed on a wall (fixedGradient) drives gas through it: the
+    solver's boundary flux check stops the run (FluidError, exit 3) naming the patch."""
+    case = column(tmp_path, sides="wall", gravity=(0, 0, -9.81), inlet=None,
+                  p_sides={"yhi": {"type": "fixedGradient", "gradient": 50.0}})
+    with pytest.raises(FluidError, match=r"gas flows through patch 'yhi' \(U noSlip, p fixedGradient\)"):
+        run(case, steps=2)
