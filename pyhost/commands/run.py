@@ -30,6 +30,19 @@ def resolved(scene) -> dict:
     return d
 
 
+def _case_copy_filter(target: Path):
+    """What a copy of a user's OpenFOAM case leaves out: earlier solver output (time folders
+    other than 0, processor folders, logs, the pipes) and the run's own output folder, which
+    lies inside the case when case.toml sits in it (``case = "."``, CFDEM's layout)."""
+    target = Path(target).resolve()
+    solver_output = shutil.ignore_patterns("processor*", ".link", "log.*", "[1-9]*", "0.[0-9]*")
+
+    def ignore(folder, names):
+        here = Path(folder).resolve()
+        return set(solver_output(folder, names)) | {n for n in names if target.is_relative_to(here / n)}
+    return ignore
+
+
 def start_fluid(scene, folder: Path):
     """The scene's fluid: a box case (pyhost.engines.fluid_case) over the domain and the plenum below
     it, inlet at its z lo, outlet at z hi, solved by collheatFoam every time.couple_every DEM
@@ -39,18 +52,20 @@ def start_fluid(scene, folder: Path):
     on the box's sides at their fixed temperature, the other walls adiabatic."""
     from foamlib import FoamFile
 
-    from pyhost.engines.fluid_case import box_case
+    from pyhost.engines.fluid_case import box_case, case_density
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
     energy = scene.effects.convection != "none"
     if f.case:                          # the user's own case, copied: the host never writes into it
         shutil.rmtree(folder, ignore_errors=True)
-        shutil.copytree(scene.folder / f.case, folder, symlinks=True,
-                        ignore=shutil.ignore_patterns("processor*", ".link", "log.*", "[1-9]*", "0.[0-9]*"))
+        shutil.copytree(scene.folder / f.case, folder, symlinks=True, ignore=_case_copy_filter(folder))
+        props = FoamFile(folder / "constant" / "transportProperties")
+        rho, where = case_density(folder)
+        if where.startswith("0/rho"):   # collheatFoam reads rho beside nu
+            props["rho"] = FoamFile.Dimensioned(name="rho", value=rho, dimensions=[1, -3, 0, 0, 0, 0, 0])
         if energy:                      # the gas's properties are the scene's, given once
-            FoamFile(folder / "constant" / "transportProperties").update({"Cp": f.heat_capacity,
-                                                                           "kappa": f.conductivity})
+            props.update({"Cp": f.heat_capacity, "kappa": f.conductivity})
         return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
@@ -147,6 +162,18 @@ def user_script(scene):
                 walls_of=walls_of)
 
 
+def driven_time(scene) -> float:
+    """How long [s] a CFD-DEM script's final ``run 0`` lasts (the coupling drives it, as in
+    CFDEM's scripts): [time] end if the scene gives it, else the fluid case's controlDict
+    endTime less its startTime."""
+    from foamlib import FoamFile
+
+    if scene.time.end > 0:
+        return scene.time.end
+    control = FoamFile(scene.folder / scene.fluid.case / "system" / "controlDict")
+    return float(control["endTime"]) - float(control.get("startTime", 0.0))
+
+
 def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None, wrap_fluid=None,
              start=None, resume: dict | None = None, link=None) -> dict:
     """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
@@ -161,7 +188,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     from pyhost.script import read_script
 
     effects = scene.effects_summary()
-    max_time = scene.time.test_end or None if (test and scene.scripted) else None
+    driven = driven_time(scene) if scene.scripted and effects["fluid_solver"] else None
+    max_time = (scene.time.test_end or (driven / 10 if driven else None)) if (test and scene.scripted) else None
     if scene.scripted:
         script, particles = scene.folder / scene.dem.script, user_script(scene)
         variables = dict(scene.dem.variables, **(scene.dem.test_variables if test else {}))
@@ -182,7 +210,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         try:
             return run_scene(scene, wrap(dem) if wrap else dem, commands, out, max_time=max_time,
                              fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
-                             end=None if scene.scripted else scene.time.end, progress_every=progress_every,
+                             end=None if scene.scripted else scene.time.end, driven=driven,
+                             progress_every=progress_every,
                              **particles)
         finally:
             dem.close()

@@ -171,3 +171,22 @@ def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, n
                                          (T0, T0 if T_inlet is None else T_inlet, T_walls.get(face))), "T")
                               for face, kind in boundaries.items()}
     return path
+
+
+def case_density(case: str | Path) -> tuple[float, str]:
+    """The gas density [kg/m^3] of a user's OpenFOAM case and where it was found: ``rho`` of
+    constant/transportProperties, else the uniform internalField of 0/rho (where CFDEM
+    cases keep it). ValueError naming the file and the key when neither gives one number."""
+    case = Path(case)
+    props = FoamFile(case / "constant" / "transportProperties")
+    if "rho" in props:
+        return float(getattr(props["rho"], "value", props["rho"])), "constant/transportProperties: rho"
+    field = case / "0" / "rho"
+    if not field.is_file():
+        raise ValueError(f"{case}: no gas density: constant/transportProperties has no rho and there is no "
+                         f"0/rho (write e.g. 'rho [1 -3 0 0 0 0 0] 1.2;' into transportProperties)")
+    value = FoamFile(field)["internalField"]
+    if not np.isscalar(value) or float(value) <= 0:
+        raise ValueError(f"{field}: internalField: the gas density must be one uniform positive value "
+                         f"(collheatFoam solves an incompressible gas), got {str(value)[:60]}")
+    return float(value), "0/rho: internalField"
