@@ -33,6 +33,7 @@ from plugins import convection
 from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
                                temperature_difference)
 from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
+from pyhost.dem_input import script_dem_contacts
 from pyhost import checkpoint, signals
 from pyhost.engines.dem import Dem
 from pyhost.failures import particles_lost
@@ -89,7 +90,7 @@ class Coupling:
                  contacts_open: bool = False, resume: dict | None = None):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
-        self.materials = list(scene.materials.values())
+        self.materials = script_dem_contacts(scene, dem) if scene.scripted else list(scene.materials.values())
         self.type_material = np.asarray(type_material, int)
         self.group_names, self.group_of = groups
         self.initial_T = initial_T
@@ -556,15 +557,20 @@ class Coupling:
 
 
 def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end: float | None = None,
-              max_time: float | None = None, progress_every: float = 5.0, log=print, **particles) -> dict:
+              max_time: float | None = None, driven: float | None = None, progress_every: float = 5.0,
+              log=print, **particles) -> dict:
     """Run a script's commands on ``dem``; each ``run N`` is N coupled steps (steps beyond
-    ``max_time`` [s] of coupled time, for smoke runs, are cut). ``walls_of(dem)`` gives the
-    HostWalls once the script's walls exist; ``particles``: type_material, groups and
-    initial_T of ``Coupling``. Returns the summary, also written when a step fails."""
-    coupling, max_steps = None, None
+    ``max_time`` [s] of coupled time, for smoke runs, are cut). ``driven`` [s]: how long the
+    script's last ``run`` lasts when it asks for 0 steps (a CFD-DEM script whose coupling
+    drives the run, as CFDEM's end in ``run 0``). ``walls_of(dem)`` gives the HostWalls once
+    the script's walls exist; ``particles``: type_material, groups and initial_T of
+    ``Coupling``. Returns the summary, also written when a step fails; a script whose runs
+    simulate no step at all is refused (ScriptError) rather than ending as done."""
+    coupling = None
     effects = scene.effects_summary()
+    last_run = max((k for k, c in enumerate(commands) if c.name == "run"), default=-1)
     try:
-        for cmd in commands:
+        for k, cmd in enumerate(commands):
             if cmd.name != "run":
                 dem.command(cmd)
                 continue
@@ -581,12 +587,19 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 coupling.start()
             else:
                 coupling.update_walls(walls_of(dem))
-                max_steps = None if max_time is None else round(max_time / dem.dt)
             n = dem.steps(run.steps, run.upto)
-            if max_steps is not None:
-                n = min(n, max_steps - coupling.steps)
+            if n == 0 and k == last_run and driven is not None:
+                n = round(driven / dem.dt)
+                log(f"{cmd.where()}: the script ends in a run of 0 steps, which the coupling drives: "
+                    f"{driven:g} s ({n} steps; [time] end, else the fluid case's controlDict endTime)")
+            if max_time is not None:
+                n = min(n, round(max_time / dem.dt) - coupling.steps)
             if n > 0:
                 coupling.advance(n)
+        if coupling is not None and coupling.steps == 0:
+            raise ScriptError(f"{scene.path}: the script's runs simulate no step (its last is "
+                              f"{commands[last_run].where()}: '{commands[last_run].text}'); give the steps in "
+                              f"the script" + (", or the coupled time as [time] end" if fluid is not None else ""))
     except BaseException as exc:          # keep what was computed: summary of the run so far
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
                 and coupling.every["checkpoint"]:
