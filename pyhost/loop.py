@@ -80,14 +80,14 @@ class Coupling:
     ``groups``: (names, function atoms -> group index per atom) for the history columns;
     ``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
     ``initial_T``: function (atoms, mask of new atoms) -> their starting temperature [K]
-    (NaN: keep the value LIGGGHTS holds); ``contacts_open``: the contacts present at the start
-    (a restart from a settled state) are not collisions: open and enduring from the start.
+    (NaN: keep the value LIGGGHTS holds). The contacts present at the start (overlaps as
+    placed, a script's read_restart of a settled bed) are not collisions: open and enduring.
     ``resume``: a checkpoint's state (pyhost.checkpoint) to continue from, its logs appended to.
     """
 
     def __init__(self, scene, dem: Dem, out: Path, *, type_material, groups, walls, initial_T, fluid=None,
                  end: float | None = None, progress_every: float = 5.0, keep_all: np.ndarray | None = None,
-                 contacts_open: bool = False, resume: dict | None = None):
+                 resume: dict | None = None):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
         self.materials = script_dem_contacts(scene, dem) if scene.scripted else list(scene.materials.values())
@@ -95,7 +95,6 @@ class Coupling:
         self.group_names, self.group_of = groups
         self.initial_T = initial_T
         self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
-        self.contacts_open = contacts_open
         self.before = None
         self.update_walls(walls)
         self.capacity = np.array([m.heat_capacity for m in self.materials])
@@ -153,7 +152,7 @@ class Coupling:
         interrupt from here on finds a coupling to write its summary)."""
         if self.ready:                    # resumed: the checkpoint's state is all there is
             return
-        if self.contacts_open and self.every["sample"]:
+        if self.every["sample"]:
             self.open_present()
         T_gas = self.fluid.temperature() if self.convection else None
         if self.fluid is not None:

@@ -113,7 +113,7 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
     return script, dict(type_material=[-1] + list(range(len(index))),
                         groups=(names, lambda atoms: group_by_id[atoms.id]),
                         initial_T=lambda atoms, new: T_by_id[atoms.id[new]],
-                        walls_of=lambda dem: walls, keep_all=group_by_id, contacts_open=start is not None)
+                        walls_of=lambda dem: walls, keep_all=group_by_id)
 
 
 def user_script(scene):
