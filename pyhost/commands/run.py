@@ -185,7 +185,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
     from pyhost.loop import run_scene
-    from pyhost.script import read_script
+    from pyhost.script import check_types, read_script
 
     effects = scene.effects_summary()
     driven = driven_time(scene) if scene.scripted and effects["fluid_solver"] else None
@@ -202,6 +202,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         particles["resume"] = resume
         variables = {}
     commands = read_script(script, scene.folder)
+    if scene.scripted:
+        check_types(commands, scene.materials, str(scene.path))
     fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None
     cwd = os.getcwd()
     try:
