@@ -165,10 +165,12 @@ class Domain:
 
 @dataclass(frozen=True)
 class Fluid:
-    case: str = spec(default="", doc="the user's OpenFOAM case folder, relative to the case folder (any mesh, "
-                                     "the user's boundary conditions; solved by collheatFoam). Its "
-                                     "transportProperties give rho and nu, its constant/g the gravity: the "
-                                     "keys density, viscosity, inlet_*, plenum, cells and sides are then unused")
+    case: str = spec(default="", doc="the user's OpenFOAM case folder, relative to the case folder ('.': "
+                                     "case.toml sits in it, as CFDEM's tutorials keep it), solved by collheatFoam "
+                                     "with its own mesh and boundary conditions (supported: docs/fluid-cases.md). "
+                                     "Its transportProperties give nu and rho (or a uniform 0/rho), its "
+                                     "constant/g the gravity, which acts on the gas: the keys density, "
+                                     "viscosity, inlet_*, plenum, cells and sides are then unused")
     density: float = spec(">0", 1.2, "[kg/m^3]")
     viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
     inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the inlet (fluid z lo) [m/s]")
@@ -180,6 +182,10 @@ class Fluid:
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
     sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")
     alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]")
+    void_fraction: str = spec("in:centre,divided", "centre",
+                              "how a particle's volume and drag go to the fluid cells: all to the cell of its "
+                              "centre, or divided over the cells it overlaps (CFDEM's divided model; for cells "
+                              "less than about 3 particle diameters wide)")
     conductivity: float = spec(">0", 0.026, "gas thermal conductivity [W/(m K)] (with effects.convection)")
     heat_capacity: float = spec(">0", 1005.0, "gas specific heat capacity [J/(kg K)] (with effects.convection)")
     temperature: float = spec(">0", 293.15, "initial gas temperature [K] (with effects.convection)")

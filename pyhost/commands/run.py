@@ -52,7 +52,7 @@ def start_fluid(scene, folder: Path):
     on the box's sides at their fixed temperature, the other walls adiabatic."""
     from foamlib import FoamFile
 
-    from pyhost.engines.fluid_case import box_case, case_density
+    from pyhost.engines.fluid_case import add_final_solvers, adopt_void_fraction, box_case, case_density
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
@@ -60,13 +60,16 @@ def start_fluid(scene, folder: Path):
     if f.case:                          # the user's own case, copied: the host never writes into it
         shutil.rmtree(folder, ignore_errors=True)
         shutil.copytree(scene.folder / f.case, folder, symlinks=True, ignore=_case_copy_filter(folder))
+        adopt_void_fraction(folder)
+        add_final_solvers(folder)
         props = FoamFile(folder / "constant" / "transportProperties")
         rho, where = case_density(folder)
         if where.startswith("0/rho"):   # collheatFoam reads rho beside nu
             props["rho"] = FoamFile.Dimensioned(name="rho", value=rho, dimensions=[1, -3, 0, 0, 0, 0, 0])
         if energy:                      # the gas's properties are the scene's, given once
             props.update({"Cp": f.heat_capacity, "kappa": f.conductivity})
-        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
+        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
+                           void_fraction=f.void_fraction).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
@@ -79,7 +82,8 @@ def start_fluid(scene, folder: Path):
                     dt=scene.time.couple_every * scene.time.dem_step,
                     T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
                     T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
-    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
+    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
+                           void_fraction=f.void_fraction).start()
 
 
 def box_world(scene, out: Path, start=None, restart: Path | None = None):

@@ -190,3 +190,42 @@ def case_density(case: str | Path) -> tuple[float, str]:
         raise ValueError(f"{field}: internalField: the gas density must be one uniform positive value "
                          f"(collheatFoam solves an incompressible gas), got {str(value)[:60]}")
     return float(value), "0/rho: internalField"
+
+
+def adopt_void_fraction(case: str | Path) -> bool:
+    """In a copy of a user's case: CFDEM keeps the fluid fraction's boundary conditions in
+    0/voidfraction (typically fixedValue 1 at inlets and outlets, so that an inlet's velocity
+    is the superficial one even where the bed touches it); collheatFoam reads them from
+    0/alpha. Writes 0/alpha from 0/voidfraction when the case has no 0/alpha; True if it did.
+    Without either, the fraction is zeroGradient on every patch."""
+    case = Path(case)
+    source, target = case / "0" / "voidfraction", case / "0" / "alpha"
+    if not source.is_file() or target.is_file():
+        return False
+    shutil.copy(source, target)
+    f = FoamFile(target)
+    f.object_ = "alpha"
+    f["internalField"] = 1.0          # the host sends the fraction before the first step
+    return True
+
+
+def add_final_solvers(case: str | Path) -> list[str]:
+    """In a copy of a user's case: OpenFOAM v1912 looks up 'XFinal' solver settings for the
+    last corrector of every field X it solves; cases written for older versions (CFDEM's
+    tutorials) give only 'X'. Adds 'XFinal' = X with relTol 0 where it is missing; returns
+    the names added."""
+    f = FoamFile(Path(case) / "system" / "fvSolution")
+    if "solvers" not in f:
+        return []
+    solvers = f["solvers"]
+    keys = list(solvers.keys())
+    added = []
+    for key in keys:
+        final = key[:-1] + 'Final"' if key.endswith('"') else key + "Final"
+        if key.endswith(('Final', 'Final"')) or final in keys:
+            continue
+        entry = dict(solvers[key])
+        entry["relTol"] = 0.0
+        f["solvers"][final] = entry
+        added.append(final)
+    return added

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from foamlib import FoamFile
 
-from pyhost.engines.fluid_case import box_case
+from pyhost.engines.fluid_case import adopt_void_fraction, box_case
 from pyhost.engines.openfoam import FluidCaseError, FluidError, FluidSolver
 
 pytestmark = pytest.mark.engines
@@ -120,3 +120,51 @@ def test_o_grid_column_keeps_a_plug_flow(tmp_path):
     assert np.abs(velocity[:, :2]).max() < 1e-5
     slope = np.polyfit(x[:, 2], pressure, 1)[0]
     assert slope == pytest.approx(-fluid.rho * 9.81, rel=1e-4)
+
+
+@pytest.mark.parametrize("cfdem_fraction", [True, False])
+def test_inlet_velocity_is_superficial_with_cfdem_void_fraction(tmp_path, cfdem_fraction):
+    """CFDEM keeps 0/voidfraction with fixedValue 1 at the inlet: the inlet's velocity is then
+    the superficial one even where particles fill the first cells (ErgunTestMPI's bed lies on
+    its inlet). adopt_void_fraction gives collheatFoam those conditions as 0/alpha. With a
+    fraction of 0.5 in every cell, the gas in the cells moves at 0.05 / 0.5 m/s; without, the
+    fraction is zeroGradient and half the gas comes in."""
+    case = column(tmp_path, sides="slip", gravity=(0, 0, -9.81), inlet=0.05,
+                  p_sides={f: ZERO_GRADIENT for f in (*WALLS, "zlo")})
+    if cfdem_fraction:
+        vf = FoamFile(case / "0" / "voidfraction")
+        vf.class_, vf.object_ = "volScalarField", "voidfraction"
+        vf.update({"dimensions": FoamFile.DimensionSet(), "internalField": 1.0,
+                   "boundaryField": {"zlo": {"type": "fixedValue", "value": 1.0},
+                                     "zhi": {"type": "fixedValue", "value": 1.0},
+                                     **{f: {"type": "zeroGradient"} for f in WALLS}}})
+        assert adopt_void_fraction(case)
+    with FluidSolver(case) as fluid:
+        fluid._alpha[:] = 0.5
+        fluid.advance(20e-3, 20)
+        _, u = fluid.fields()
+    # (the outlet's fixed fraction of 1 bends the top cells' flow by about 0.1 %)
+    assert u[:, 2] == pytest.approx(0.1 if cfdem_fraction else 0.05, rel=3e-3)
+    assert np.median(u[:, 2]) == pytest.approx(0.1 if cfdem_fraction else 0.05, rel=1e-5)
+
+
+@pytest.mark.parametrize("rule", ["centre", "divided"])
+def test_divided_void_fraction_shares_a_particle_between_cells(tmp_path, rule):
+    """A 6 mm sphere whose centre lies 1.5 mm (r/2) short of the face between two 10 mm
+    cells has 15.6 % of its volume beyond the face (a cap of height r/2). 'centre' gives
+    the far cell nothing; 'divided' (15 points) gives it 22 %, within half the cap of the
+    exact share. The solid volume is conserved either way."""
+    case = box_case(tmp_path / "fluid", lo=(0, 0, 0), hi=(0.02, 0.01, 0.01), cells=(2, 1, 1),
+                    boundaries={f: "wall" for f in (*WALLS, "zlo", "zhi")}, dt=1e-3, **AIR)
+    d, h = 0.006, 0.0015
+    volume = np.pi * d**3 / 6
+    cap = np.pi * h**2 * (1.5 * d - h) / 3 / volume                # exact share beyond the face
+    with FluidSolver(case, void_fraction=rule) as fluid:
+        fluid.particle_forces(np.array([[0.01 - h, 0.005, 0.005]]), np.zeros((1, 3)), np.array([d]))
+        solid = (1 - fluid.alpha) * fluid.cell_volumes / volume
+    print(f"{rule}: share beyond the face {solid[1]:.3f}, exact {cap:.3f}")
+    assert solid.sum() == pytest.approx(1.0, rel=1e-12)
+    if rule == "divided":
+        assert abs(solid[1] - cap) < 0.5 * cap
+    else:
+        assert solid[1] == 0.0
