@@ -166,3 +166,55 @@ def dem_collision_time(scene: Scene, v: float) -> float:
         mass = 4.0 / 3.0 * math.pi * grp.radius**3 * m.density
         times.append(hertz_collision_time(E, grp.radius / 2.0, mass / 2.0, v))
     return min(times)
+
+
+SCRIPT_DEM = (("youngs_modulus", "youngsModulus"), ("poisson_ratio", "poissonsRatio"),
+              ("restitution", "coefficientRestitution"), ("friction", "coefficientFriction"))
+"""DemContact field and the script's property/global that sets it (per type, or per type pair
+for restitution and friction, read on the diagonal)."""
+
+
+def script_dem_contacts(scene, dem) -> list:
+    """The scene's materials with the DEM contact the user's script sets (``dem``: the engine
+    after the script's set-up): that of the material's first atom type, or for a wall material
+    the type of the first [[walls]] fix made of it. A ``[materials.X].dem`` table given as well
+    must agree on what it states (youngs_modulus, restitution, and poisson_ratio or friction
+    where they differ from their defaults): ScriptError naming both places otherwise. A
+    material with neither a type nor a wall keeps its table (None: never needed)."""
+    import dataclasses
+
+    from pyhost.scene import DemContact
+    from pyhost.script import ScriptError
+
+    wall_of = {}
+    for w in scene.walls:
+        wall_of.setdefault(w.material, w.fix)
+    defaults = DemContact(youngs_modulus=1.0, restitution=1.0)
+    out = []
+    for name, m in scene.materials.items():
+        t = m.types[0] if m.types else dem.info.wall_type(wall_of[name]) if name in wall_of else None
+        if t is None:
+            out.append(m)
+            continue
+        values = {}
+        for key, prop in SCRIPT_DEM:
+            if prop not in dem.info.globals:
+                continue
+            pairwise = key in ("restitution", "friction")
+            values[key] = float(dem.type_pair_value(prop, t, t) if pairwise else dem.type_values(prop, [t])[0])
+        if m.dem is not None:
+            for key, prop in SCRIPT_DEM:
+                given = getattr(m.dem, key)
+                stated = key in ("youngs_modulus", "restitution") or given != getattr(defaults, key)
+                if stated and key in values and not math.isclose(given, values[key], rel_tol=1e-9):
+                    raise ScriptError(f"{scene.path}: materials.{name}.dem.{key} = {given:g} differs from the "
+                                      f"script's {prop} {values[key]:g} of atom type {t}: the script's value is the "
+                                      f"one LIGGGHTS uses; drop the dem table or give the same value")
+        missing = [k for k in ("youngs_modulus", "restitution") if k not in values]
+        if missing and m.dem is None:
+            raise ScriptError(f"{scene.path}: materials.{name}: the script sets no "
+                              f"{', '.join(p for k, p in SCRIPT_DEM if k in missing)} for atom type {t}; "
+                              f"give materials.{name}.dem")
+        base = m.dem or defaults
+        out.append(dataclasses.replace(m, dem=dataclasses.replace(base, **values)))
+    return out

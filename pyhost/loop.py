@@ -33,6 +33,7 @@ from plugins import convection
 from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
                                temperature_difference)
 from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
+from pyhost.dem_input import script_dem_contacts
 from pyhost import checkpoint, signals
 from pyhost.engines.dem import Dem
 from pyhost.failures import particles_lost
@@ -79,22 +80,21 @@ class Coupling:
     ``groups``: (names, function atoms -> group index per atom) for the history columns;
     ``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
     ``initial_T``: function (atoms, mask of new atoms) -> their starting temperature [K]
-    (NaN: keep the value LIGGGHTS holds); ``contacts_open``: the contacts present at the start
-    (a restart from a settled state) are not collisions: open and enduring from the start.
+    (NaN: keep the value LIGGGHTS holds). The contacts present at the start (overlaps as
+    placed, a script's read_restart of a settled bed) are not collisions: open and enduring.
     ``resume``: a checkpoint's state (pyhost.checkpoint) to continue from, its logs appended to.
     """
 
     def __init__(self, scene, dem: Dem, out: Path, *, type_material, groups, walls, initial_T, fluid=None,
                  end: float | None = None, progress_every: float = 5.0, keep_all: np.ndarray | None = None,
-                 contacts_open: bool = False, resume: dict | None = None):
+                 resume: dict | None = None):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
-        self.materials = list(scene.materials.values())
+        self.materials = script_dem_contacts(scene, dem) if scene.scripted else list(scene.materials.values())
         self.type_material = np.asarray(type_material, int)
         self.group_names, self.group_of = groups
         self.initial_T = initial_T
         self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
-        self.contacts_open = contacts_open
         self.before = None
         self.update_walls(walls)
         self.capacity = np.array([m.heat_capacity for m in self.materials])
@@ -106,15 +106,16 @@ class Coupling:
         self.totals = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0,
                            heat_from_walls=0.0, capped=0, clipped=0, heat_gran_undone=0.0,
                            inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0,
+                           energy_mass_change=0.0,
                            heat_convected=0.0, heat_convected_gross=0.0)
         self.CT_by_id = np.zeros(0)      # m c T of each id at its last sample [J] (energy balance)
+        self.M_by_id = np.zeros(0)       # mass of each id at its last sample [kg] (0: not known)
         self.seen = np.zeros(0, bool)
         self.warned = set()
         self.heat = self.effects["particle_temperatures"]
         self.convection = self.effects["convection"] and fluid is not None
         self.laws = {}
-        if self.heat and dem.info.heat_gran:
-            self.check_capacities()
+        self.check_heat_gran()
         if resume is None:
             self.track_particles(dem.atoms(self.heat))
             self.CT0 = self.totals.pop("energy_in")
@@ -152,7 +153,7 @@ class Coupling:
         interrupt from here on finds a coupling to write its summary)."""
         if self.ready:                    # resumed: the checkpoint's state is all there is
             return
-        if self.contacts_open and self.every["sample"]:
+        if self.every["sample"]:
             self.open_present()
         T_gas = self.fluid.temperature() if self.convection else None
         if self.fluid is not None:
@@ -214,15 +215,17 @@ class Coupling:
 
     def resync(self) -> None:
         """Before each run: heat content that the script's own commands changed since the last
-        run (e.g. ``set ... property/atom Temp``) enters the balance as set by the script."""
+        run (e.g. ``set ... property/atom Temp``) enters the balance as set by the script (at
+        the masses of the last sample: a mass change is ``track_particles``' term)."""
         atoms = self.dem.atoms(True)
         known = np.zeros(len(atoms.id), bool)
         inside = atoms.id < len(self.seen)
         known[inside] = self.seen[atoms.id[inside]]
         if known.any():
-            C = atoms.mass[known] * self.capacity[self.materials_of(atoms.type[known])]
-            self.totals["energy_set_by_script"] += float(np.sum(C * atoms.T[known])
-                                                         - self.CT_by_id[atoms.id[known]].sum())
+            ids = atoms.id[known]
+            m = np.where(self.M_by_id[ids] > 0, self.M_by_id[ids], atoms.mass[known])
+            C = m * self.capacity[self.materials_of(atoms.type[known])]
+            self.totals["energy_set_by_script"] += float(np.sum(C * atoms.T[known]) - self.CT_by_id[ids].sum())
         self.track_particles(atoms)
 
     # -- checkpoint (pyhost.checkpoint writes and reads the files) ---------------------------
@@ -233,7 +236,7 @@ class Coupling:
         values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, CT0=self.CT0,
                       gas_energy0=getattr(self, "gas_energy0", 0.0), warned=sorted(self.warned), logs=logs)
         arrays = dict(open_keys=self.tracker.open_keys, contact_info=self.info, CT_by_id=self.CT_by_id,
-                      seen=self.seen)
+                      seen=self.seen, M_by_id=self.M_by_id)
         return values, arrays
 
     def restore(self, state: dict) -> None:
@@ -244,6 +247,8 @@ class Coupling:
         self.tracker.update(state["open_keys"])
         self.info = np.asarray(state["contact_info"], float).reshape(-1, len(OPEN_COLUMNS))
         self.CT_by_id, self.seen = state["CT_by_id"], state["seen"]
+        self.M_by_id = state.get("M_by_id", np.zeros(len(self.seen)))
+        self.totals.setdefault("energy_mass_change", 0.0)
         checkpoint.restore_forces(self.dem, state)
 
     # -- particles ----------------------------------------------------------------------
@@ -259,7 +264,10 @@ class Coupling:
     def track_particles(self, atoms) -> None:
         """Inserted particles: their material's temperature (if the scene gives one) and their
         heat content enters the balance; departed ones (deleted, lost) leave it with the heat
-        content of their last sample."""
+        content of their last sample; particles whose mass changed since their last sample
+        (a script's fix adapt, set ... density) change their heat content by c dm T, the
+        balance's ``energy_mass_change`` (at the current T: the heat the host moved in between
+        went in at the old mass's capacity, so the two add up to the change of m c T exactly)."""
         if not self.heat:
             return
         ids = atoms.id
@@ -268,14 +276,26 @@ class Coupling:
             grow = max(top, 2 * len(self.seen)) - len(self.seen)
             self.seen = np.r_[self.seen, np.zeros(grow, bool)]
             self.CT_by_id = np.r_[self.CT_by_id, np.zeros(grow)]
+            self.M_by_id = np.r_[self.M_by_id, np.zeros(grow)]
         mat = self.materials_of(atoms.type)
         C = atoms.mass * self.capacity[mat]
         new = ~self.seen[ids]
         if new.any():
             T_set = self.initial_T(atoms, new)
             atoms.T[new] = np.where(np.isnan(T_set), atoms.T[new], T_set)
+            cold = new & ~(atoms.T > 0)
+            if cold.any():
+                k = np.flatnonzero(cold)[0]
+                name = list(self.scene.materials)[mat[k]]
+                raise ScriptError(f"{self.scene.path}: particle {atoms.id[k]} (type {atoms.type[k]}, materials.{name}) "
+                                  f"starts at {atoms.T[k]:g} K: temperatures must be above 0 K; give "
+                                  f"materials.{name}.temperature, or the script's fix heat/gran initial_temperature")
             self.totals["inserted"] += int(new.sum())
             self.totals["energy_in"] += float(np.sum(C[new] * atoms.T[new]))
+        old = ~new & (self.M_by_id[ids] > 0)
+        dm = atoms.mass[old] - self.M_by_id[ids[old]]
+        if dm.any():
+            self.totals["energy_mass_change"] += float(np.sum(self.capacity[mat[old]] * dm * atoms.T[old]))
         present = np.zeros(len(self.seen), bool)
         present[ids] = True
         gone = self.seen & ~present
@@ -283,8 +303,10 @@ class Coupling:
             self.totals["departed"] += int(gone.sum())
             self.totals["energy_out"] += float(self.CT_by_id[gone].sum())
             self.seen[gone] = False
+            self.M_by_id[gone] = 0.0
         self.seen[ids] = True
         self.CT_by_id[ids] = C * atoms.T
+        self.M_by_id[ids] = atoms.mass
         self.C = C
 
     # -- contacts -----------------------------------------------------------------------
@@ -322,6 +344,20 @@ class Coupling:
             e = self.dem.type_pair_value("coefficientRestitution", a, b)
             self.laws[a, b] = DemHertz(1.0 / ((1 - nu[0] ** 2) / E[0] + (1 - nu[1] ** 2) / E[1]), e)
         return self.laws[a, b]
+
+    def check_heat_gran(self) -> None:
+        """At each of a script's runs: a fix heat/gran that appeared has its capacities checked
+        (``check_capacities``). One defined after the first run came too late for the contact
+        compute's heatFlux column (LIGGGHTS refuses the column without the fix), so its
+        conduction during collisions cannot be taken back: said once, with what it means."""
+        if not (self.heat and self.dem.info.heat_gran):
+            return
+        self.check_capacities()
+        if not self.dem.has_heat_flux() and "heat_gran_late" not in self.warned:
+            self.warned.add("heat_gran_late")
+            print(f"warning: fix heat/gran {self.dem.info.heat_gran!r} comes after the script's first run: its "
+                  "conduction through a contact during the collision's model time is not taken back, so that "
+                  "stretch is counted by both (see heat_gran_undone: 0); define it before the first run to avoid it")
 
     def check_capacities(self) -> None:
         """A script's fix heat/gran integrates Temp with its own thermalCapacity: it must be the
@@ -538,9 +574,9 @@ class Coupling:
             self.track_particles(atoms)
             CT = float(np.sum(self.C * atoms.T))
             t = self.totals
-            came_in = self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"])
+            came_in = self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"]) + abs(t["energy_mass_change"])
             residual = (CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]
-                        - t["energy_set_by_script"] - t["heat_convected"])                    # J
+                        - t["energy_set_by_script"] - t["energy_mass_change"] - t["heat_convected"])   # J
             summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT,
                            energy_balance_error=residual / max(came_in, 1e-300))             # relative to all that came in
             if self.convection and status == "completed":   # particles and gas; the gas gains through its boundaries
@@ -556,15 +592,20 @@ class Coupling:
 
 
 def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end: float | None = None,
-              max_time: float | None = None, progress_every: float = 5.0, log=print, **particles) -> dict:
+              max_time: float | None = None, driven: float | None = None, progress_every: float = 5.0,
+              log=print, **particles) -> dict:
     """Run a script's commands on ``dem``; each ``run N`` is N coupled steps (steps beyond
-    ``max_time`` [s] of coupled time, for smoke runs, are cut). ``walls_of(dem)`` gives the
-    HostWalls once the script's walls exist; ``particles``: type_material, groups and
-    initial_T of ``Coupling``. Returns the summary, also written when a step fails."""
-    coupling, max_steps = None, None
+    ``max_time`` [s] of coupled time, for smoke runs, are cut). ``driven`` [s]: how long the
+    script's last ``run`` lasts when it asks for 0 steps (a CFD-DEM script whose coupling
+    drives the run, as CFDEM's end in ``run 0``). ``walls_of(dem)`` gives the HostWalls once
+    the script's walls exist; ``particles``: type_material, groups and initial_T of
+    ``Coupling``. Returns the summary, also written when a step fails; a script whose runs
+    simulate no step at all is refused (ScriptError) rather than ending as done."""
+    coupling = None
     effects = scene.effects_summary()
+    last_run = max((k for k, c in enumerate(commands) if c.name == "run"), default=-1)
     try:
-        for cmd in commands:
+        for k, cmd in enumerate(commands):
             if cmd.name != "run":
                 dem.command(cmd)
                 continue
@@ -581,12 +622,21 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 coupling.start()
             else:
                 coupling.update_walls(walls_of(dem))
-                max_steps = None if max_time is None else round(max_time / dem.dt)
+                coupling.check_heat_gran()
             n = dem.steps(run.steps, run.upto)
-            if max_steps is not None:
-                n = min(n, max_steps - coupling.steps)
+            if n == 0 and k == last_run and driven is not None:
+                n = round(driven / dem.dt)
+                log(f"{cmd.where()}: the script ends in a run of 0 steps, which the coupling drives: "
+                    f"{driven:g} s ({n} steps; [time] end, else the fluid case's controlDict endTime)")
+            if max_time is not None:
+                n = min(n, round(max_time / dem.dt) - coupling.steps)
             if n > 0:
                 coupling.advance(n)
+            dem.report_warnings(cmd)
+        if coupling is not None and coupling.steps == 0:
+            raise ScriptError(f"{scene.path}: the script's runs simulate no step (its last is "
+                              f"{commands[last_run].where()}: '{commands[last_run].text}'); give the steps in "
+                              f"the script" + (", or the coupled time as [time] end" if fluid is not None else ""))
     except BaseException as exc:          # keep what was computed: summary of the run so far
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
                 and coupling.every["checkpoint"]:

@@ -338,6 +338,11 @@ class Post:
         laws = {}
         for a, b in set(zip(mi.tolist(), mj.tolist())):
             A, B = mats[a].dem, mats[b].dem
+            for k, d in ((a, A), (b, B)):
+                if d is None:
+                    raise ValueError(f"{self.scene.path}: materials.{list(self.scene.materials)[k]}.dem: post "
+                                     f"recovers impact speeds with the DEM's contact law and reads no script "
+                                     f"values: give the table (youngs_modulus, restitution, poisson_ratio)")
             Y = 1.0 / ((1 - A.poisson_ratio**2) / A.youngs_modulus + (1 - B.poisson_ratio**2) / B.youngs_modulus)
             laws[a, b] = (Y, DemHertz(Y, 0.5 * (A.restitution + B.restitution)))
         return laws

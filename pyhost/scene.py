@@ -125,7 +125,9 @@ class Material:
     yield_stress: float = spec(">0", doc="[Pa]")
     heat_capacity: float = spec(">0", doc="[J/(kg K)]")
     conductivity: float = spec(">0", doc="[W/(m K)]")
-    dem: DemContact = spec(doc="the DEM's softened contact")
+    dem: DemContact | None = spec(default=None, doc="the DEM's softened contact: required for box scenes; a "
+                                                  "script scene reads it from the script's fix property/global "
+                                                  "(checked against this table if given)")
     b1: float = spec(">0", 1.1, "mean pressure at first yield / Y [-]")
     b2: float = spec(">0", 2.8, "fully plastic mean pressure / Y [-]")
     types: list = spec(default=[], doc="LIGGGHTS atom types made of this material (script scenes)")
@@ -163,10 +165,12 @@ class Domain:
 
 @dataclass(frozen=True)
 class Fluid:
-    case: str = spec(default="", doc="the user's OpenFOAM case folder, relative to the case folder (any mesh, "
-                                     "the user's boundary conditions; solved by collheatFoam). Its "
-                                     "transportProperties give rho and nu, its constant/g the gravity: the "
-                                     "keys density, viscosity, inlet_*, plenum, cells and sides are then unused")
+    case: str = spec(default="", doc="the user's OpenFOAM case folder, relative to the case folder ('.': "
+                                     "case.toml sits in it, as CFDEM's tutorials keep it), solved by collheatFoam "
+                                     "with its own mesh and boundary conditions (supported: docs/fluid-cases.md). "
+                                     "Its transportProperties give nu and rho (or a uniform 0/rho), its "
+                                     "constant/g the gravity, which acts on the gas: the keys density, "
+                                     "viscosity, inlet_*, plenum, cells and sides are then unused")
     density: float = spec(">0", 1.2, "[kg/m^3]")
     viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
     inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the inlet (fluid z lo) [m/s]")
@@ -178,6 +182,10 @@ class Fluid:
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
     sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")
     alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]")
+    void_fraction: str = spec("in:centre,divided", "centre",
+                              "how a particle's volume and drag go to the fluid cells: all to the cell of its "
+                              "centre, or divided over the cells it overlaps (CFDEM's divided model; for cells "
+                              "less than about 3 particle diameters wide)")
     conductivity: float = spec(">0", 0.026, "gas thermal conductivity [W/(m K)] (with effects.convection)")
     heat_capacity: float = spec(">0", 1005.0, "gas specific heat capacity [J/(kg K)] (with effects.convection)")
     temperature: float = spec(">0", 293.15, "initial gas temperature [K] (with effects.convection)")
@@ -211,7 +219,9 @@ class Dem:
 @dataclass(frozen=True)
 class Time:
     dem_step: float = spec(">=0", 0.0, "DEM time step [s] (box scenes; a script sets its own)")
-    end: float = spec(">=0", 0.0, "simulated time [s] (box scenes; a script's runs set it)")
+    end: float = spec(">=0", 0.0, "simulated time [s] (box scenes; a script's runs set it, except a CFD-DEM "
+                                  "script's final 'run 0', which the coupling drives for this long, else for "
+                                  "the fluid case's controlDict endTime)")
     sample_every: int = spec(">0", 1, "DEM steps between contact samples")
     couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
@@ -286,6 +296,8 @@ def _build(cls, data, where: str, file: str):
                 raise SceneError(f"{file}: {key}: missing ({f.metadata.get('doc', '')})")
             continue
         value, kind = data[name], hints[name]
+        if type(None) in typing.get_args(kind):         # an optional table: X | None
+            kind = next(k for k in typing.get_args(kind) if k is not type(None))
         if dataclasses.is_dataclass(kind):
             values[name] = _build(kind, value, key, file)
             continue
@@ -374,6 +386,10 @@ def load_scene(path) -> Scene:
         particles, domain = [], None
         _types(materials, walls, file)
     else:
+        for name, m in materials.items():
+            if m.dem is None:
+                raise SceneError(f"{file}: materials.{name}.dem: missing (the DEM's softened contact; a box scene "
+                                 "has no script to read it from)")
         particles, domain = _box_world(data, materials, walls, file)
     for k, item in enumerate(walls):
         if item.material not in materials:
@@ -436,6 +452,11 @@ def _user_fluid_case(fluid, path, file, energy: bool):
         raise SceneError(f"{file}: fluid.case: {folder} lacks what collheatFoam needs: {', '.join(missing)}")
     from pyhost.engines.foam_case_check import check_case
     check_case(folder, file, fluid.ranks, energy)
+    from pyhost.engines.fluid_case import case_density
+    try:
+        case_density(folder)
+    except ValueError as exc:
+        raise SceneError(f"{file}: fluid.case: {exc}") from None
     default = Fluid()
     for key in ("density", "viscosity", "inlet_velocity", "inlet_table", "plenum", "cells", "sides",
                 "temperature", "inlet_temperature"):

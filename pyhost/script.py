@@ -103,6 +103,26 @@ def read_script(path: str | Path, folder: str | Path | None = None, _depth: int 
     return commands
 
 
+def check_types(commands: list[Command], materials: dict, where: str) -> None:
+    """Types the scene gives its materials must exist: a type above the script's
+    ``create_box N`` would end LIGGGHTS' process (an out-of-bounds index in a property/global)
+    at the first run; ScriptError naming the material, the type and the create_box line,
+    before any engine time. A script that reads its box (read_restart, read_data) is checked
+    by LIGGGHTS itself."""
+    box = next((c for c in commands if c.name == "create_box"), None)
+    if box is None:
+        return
+    try:
+        n = int(box.words[1])
+    except (IndexError, ValueError):
+        return                                  # a $variable: LIGGGHTS resolves it
+    for name, m in materials.items():
+        for t in m.types:
+            if t > n:
+                raise ScriptError(f"{where}: materials.{name}.types: atom type {t} does not exist: "
+                                  f"{box.where()} creates {n} atom type{'s' if n > 1 else ''}")
+
+
 @dataclass(frozen=True)
 class RunCommand:
     """``run N [upto] [pre yes|no] [post yes|no]``: steps (possibly a $variable, evaluated by

@@ -30,6 +30,21 @@ def resolved(scene) -> dict:
     return d
 
 
+def _case_copy_filter(target: Path):
+    """What a copy of a user's OpenFOAM case leaves out: earlier solver output (time folders
+    other than 0, processor folders, logs, the pipes) and the run's own output folder, which
+    lies inside the case when case.toml sits in it (``case = "."``, CFDEM's layout), as do
+    earlier runs' output folders (holding scene.json) written with another --out."""
+    target = Path(target).resolve()
+    solver_output = shutil.ignore_patterns("processor*", ".link", "log.*", "[1-9]*", "0.[0-9]*")
+
+    def ignore(folder, names):
+        here = Path(folder).resolve()
+        return set(solver_output(folder, names)) | {n for n in names if target.is_relative_to(here / n)
+                                                     or (here / n / "scene.json").is_file()}
+    return ignore
+
+
 def start_fluid(scene, folder: Path):
     """The scene's fluid: a box case (pyhost.engines.fluid_case) over the domain and the plenum below
     it, inlet at its z lo, outlet at z hi, solved by collheatFoam every time.couple_every DEM
@@ -39,8 +54,7 @@ def start_fluid(scene, folder: Path):
     on the box's sides at their fixed temperature, the other walls adiabatic."""
     from foamlib import FoamFile
 
-    from pyhost.engines.fluid_case import box_case
-    from pyhost.engines.foam_case_check import density
+    from pyhost.engines.fluid_case import add_final_solvers, adopt_void_fraction, box_case, case_density
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
@@ -48,14 +62,18 @@ def start_fluid(scene, folder: Path):
     if f.case:                          # the user's own case, copied: the host never writes into it
         source = (scene.folder / f.case).resolve()
         shutil.rmtree(folder, ignore_errors=True)
-        shutil.copytree(source, folder, symlinks=True, ignore=_case_ignore(source, folder))
+        shutil.copytree(source, folder, symlinks=True, ignore=_case_copy_filter(folder))
+        adopt_void_fraction(folder)
+        add_final_solvers(folder)
         props = FoamFile(folder / "constant" / "transportProperties")
-        if "rho" not in props:          # kept in 0/rho (CFDEM cases); collheatFoam reads it here
-            props["rho"] = density(source, str(scene.path))
+        rho, where = case_density(folder)
+        if where.startswith("0/rho"):   # collheatFoam reads rho beside nu
+            props["rho"] = FoamFile.Dimensioned(name="rho", value=rho, dimensions=[1, -3, 0, 0, 0, 0, 0])
         if energy:                      # the gas's properties are the scene's, given once
             props.update({"Cp": f.heat_capacity, "kappa": f.conductivity})
         _mesh(folder, source, str(scene.path))
-        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
+        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
+                           void_fraction=f.void_fraction).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
@@ -68,28 +86,8 @@ def start_fluid(scene, folder: Path):
                     dt=scene.time.couple_every * scene.time.dem_step,
                     T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
                     T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
-    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks).start()
-
-
-def _case_ignore(source: Path, copy: Path):
-    """What a copy of the user's case leaves out: the copy itself and any run's output
-    (a folder holding scene.json) when the case folder holds them (``case = "."``), time
-    folders other than 0, processor folders, logs and the solver's pipes."""
-    def ignore(where, names):
-        where = Path(where)
-        left = {n for n in names if n.startswith(("processor", "log.")) or n == ".link"
-                or copy.is_relative_to((where / n).resolve()) or (where / n / "scene.json").is_file()}
-        if where.resolve() == source:
-            left |= {n for n in names if _time_folder(n) and (where / n).is_dir()}
-        return left
-    return ignore
-
-
-def _time_folder(name: str) -> bool:
-    try:
-        return float(name) != 0
-    except ValueError:
-        return False
+    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
+                           void_fraction=f.void_fraction).start()
 
 
 def _mesh(case: Path, source: Path, file: str) -> None:
@@ -141,7 +139,7 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
     return script, dict(type_material=[-1] + list(range(len(index))),
                         groups=(names, lambda atoms: group_by_id[atoms.id]),
                         initial_T=lambda atoms, new: T_by_id[atoms.id[new]],
-                        walls_of=lambda dem: walls, keep_all=group_by_id, contacts_open=start is not None)
+                        walls_of=lambda dem: walls, keep_all=group_by_id)
 
 
 def user_script(scene):
@@ -190,6 +188,18 @@ def user_script(scene):
                 walls_of=walls_of)
 
 
+def driven_time(scene) -> float:
+    """How long [s] a CFD-DEM script's final ``run 0`` lasts (the coupling drives it, as in
+    CFDEM's scripts): [time] end if the scene gives it, else the fluid case's controlDict
+    endTime less its startTime."""
+    from foamlib import FoamFile
+
+    if scene.time.end > 0:
+        return scene.time.end
+    control = FoamFile(scene.folder / scene.fluid.case / "system" / "controlDict")
+    return float(control["endTime"]) - float(control.get("startTime", 0.0))
+
+
 def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None, wrap_fluid=None,
              start=None, resume: dict | None = None, link=None) -> dict:
     """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
@@ -201,10 +211,11 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
     from pyhost.loop import run_scene
-    from pyhost.script import read_script
+    from pyhost.script import check_types, read_script
 
     effects = scene.effects_summary()
-    max_time = scene.time.test_end or None if (test and scene.scripted) else None
+    driven = driven_time(scene) if scene.scripted and effects["fluid_solver"] else None
+    max_time = (scene.time.test_end or (driven / 10 if driven else None)) if (test and scene.scripted) else None
     if scene.scripted:
         script, particles = scene.folder / scene.dem.script, user_script(scene)
         variables = dict(scene.dem.variables, **(scene.dem.test_variables if test else {}))
@@ -217,6 +228,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         particles["resume"] = resume
         variables = {}
     commands = read_script(script, scene.folder)
+    if scene.scripted:
+        check_types(commands, scene.materials, str(scene.path))
     fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None
     cwd = os.getcwd()
     try:
@@ -225,7 +238,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         try:
             return run_scene(scene, wrap(dem) if wrap else dem, commands, out, max_time=max_time,
                              fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
-                             end=None if scene.scripted else scene.time.end, progress_every=progress_every,
+                             end=None if scene.scripted else scene.time.end, driven=driven,
+                             progress_every=progress_every,
                              **particles)
         finally:
             dem.close()

@@ -93,6 +93,7 @@ class Dem:
         self.log = log
         self.pair_cols = self.wall_cols = None
         self._warned_mesh = False
+        self._warnings = set()    # LIGGGHTS warnings already shown
         self._pending = None      # under MPI: the last gathered atoms, their T and v as gathered
         self._counts = None       # under MPI: atoms per rank in the last gather
 
@@ -122,6 +123,16 @@ class Dem:
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()}: {exc}") from None
         self.info.learn(cmd)
+        self.report_warnings(cmd)
+
+    def report_warnings(self, cmd: Command | None = None) -> None:
+        """LIGGGHTS' own warnings since the last report, on screen once each (they used to stay
+        in OUT/dem/log.liggghts): after each script command and each script run."""
+        for line in self.lmp.new_warnings():
+            if line not in self._warnings:
+                self._warnings.add(line)
+                where = f" (after {cmd.where()})" if cmd is not None else ""
+                self.log(f"LIGGGHTS {line}{where}; each warning is shown once, all are in {self.lmp.log}")
 
     @collective
     def steps(self, steps: str, upto: bool) -> int:
@@ -286,6 +297,10 @@ class Dem:
         if fix is None:
             raise ScriptError(f"the script sets no 'fix ... property/global {prop} ...', which the host needs")
         return fix
+
+    def has_heat_flux(self) -> bool:
+        """Whether the pair contact compute has heat/gran's heatFlux column."""
+        return self.info.pair_compute is not None and "heatFlux" in self.info.pair_compute[1]
 
     # -- contacts ---------------------------------------------------------------------
     def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:

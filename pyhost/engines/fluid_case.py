@@ -171,3 +171,61 @@ def box_case(path: str | Path, *, lo, hi, cells, boundaries: dict, rho: float, n
                                          (T0, T0 if T_inlet is None else T_inlet, T_walls.get(face))), "T")
                               for face, kind in boundaries.items()}
     return path
+
+
+def case_density(case: str | Path) -> tuple[float, str]:
+    """The gas density [kg/m^3] of a user's OpenFOAM case and where it was found: ``rho`` of
+    constant/transportProperties, else the uniform internalField of 0/rho (where CFDEM
+    cases keep it). ValueError naming the file and the key when neither gives one number."""
+    case = Path(case)
+    props = FoamFile(case / "constant" / "transportProperties")
+    if "rho" in props:
+        return float(getattr(props["rho"], "value", props["rho"])), "constant/transportProperties: rho"
+    field = case / "0" / "rho"
+    if not field.is_file():
+        raise ValueError(f"{case}: no gas density: constant/transportProperties has no rho and there is no "
+                         f"0/rho (write e.g. 'rho [1 -3 0 0 0 0 0] 1.2;' into transportProperties)")
+    value = FoamFile(field)["internalField"]
+    if not np.isscalar(value) or float(value) <= 0:
+        raise ValueError(f"{field}: internalField: the gas density must be one uniform positive value "
+                         f"(collheatFoam solves an incompressible gas), got {str(value)[:60]}")
+    return float(value), "0/rho: internalField"
+
+
+def adopt_void_fraction(case: str | Path) -> bool:
+    """In a copy of a user's case: CFDEM keeps the fluid fraction's boundary conditions in
+    0/voidfraction (typically fixedValue 1 at inlets and outlets, so that an inlet's velocity
+    is the superficial one even where the bed touches it); collheatFoam reads them from
+    0/alpha. Writes 0/alpha from 0/voidfraction when the case has no 0/alpha; True if it did.
+    Without either, the fraction is zeroGradient on every patch."""
+    case = Path(case)
+    source, target = case / "0" / "voidfraction", case / "0" / "alpha"
+    if not source.is_file() or target.is_file():
+        return False
+    shutil.copy(source, target)
+    f = FoamFile(target)
+    f.object_ = "alpha"
+    f["internalField"] = 1.0          # the host sends the fraction before the first step
+    return True
+
+
+def add_final_solvers(case: str | Path) -> list[str]:
+    """In a copy of a user's case: OpenFOAM v1912 looks up 'XFinal' solver settings for the
+    last corrector of every field X it solves; cases written for older versions (CFDEM's
+    tutorials) give only 'X'. Adds 'XFinal' = X with relTol 0 where it is missing; returns
+    the names added."""
+    f = FoamFile(Path(case) / "system" / "fvSolution")
+    if "solvers" not in f:
+        return []
+    solvers = f["solvers"]
+    keys = list(solvers.keys())
+    added = []
+    for key in keys:
+        final = key[:-1] + 'Final"' if key.endswith('"') else key + "Final"
+        if key.endswith(('Final', 'Final"')) or final in keys:
+            continue
+        entry = dict(solvers[key])
+        entry["relTol"] = 0.0
+        f["solvers"][final] = entry
+        added.append(final)
+    return added

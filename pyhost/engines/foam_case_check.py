@@ -3,12 +3,12 @@ mistake in it is bad input (exit 2) naming the file, the key and what to write, 
 solver that dies at its first step (exit 3).
 
 ``check_case(folder, file, ranks, energy)`` reads with foamlib: every file it needs parses;
-the gas density ``rho`` (kg/m^3) in constant/transportProperties or, as CFDEM cases keep it,
-the uniform internalField of 0/rho; ``nu``; the mesh's patches (constant/polyMesh/boundary,
-else system/blockMeshDict's ``boundary`` or old-style ``patches``) each with an entry in 0/U
-and 0/p (0/T with the gas energy) by name, group or quoted regular expression; blocks and
-faces naming existing vertices; with ``ranks`` > 1, system/decomposeParDict cutting the mesh
-into that many subdomains. ``density(folder, file)`` is the gas density.
+``nu`` and, if given there, ``rho`` in constant/transportProperties are numbers (a density
+kept in 0/rho is ``pyhost.engines.fluid_case.case_density``'s); the mesh's patches
+(constant/polyMesh/boundary, else system/blockMeshDict's ``boundary`` or old-style
+``patches``) each with an entry in 0/U and 0/p (0/T with the gas energy) by name, group or
+quoted regular expression; blocks and faces naming existing vertices; with ``ranks`` > 1,
+system/decomposeParDict cutting the mesh into that many subdomains.
 """
 from __future__ import annotations
 
@@ -38,26 +38,6 @@ def _read(folder: Path, rel: str, file: str) -> dict:
 def _number(entry) -> float | None:
     value = getattr(entry, "value", entry)
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
-
-
-def density(folder: Path, file: str) -> float:
-    """``rho`` (kg/m^3) from constant/transportProperties, else from the uniform
-    internalField of 0/rho."""
-    props = _read(folder, "constant/transportProperties", file)
-    where = f"{file}: fluid.case: {folder / 'constant/transportProperties'}"
-    if "rho" in props:
-        rho, source = _number(props["rho"]), f"{where}: rho"
-    elif (folder / "0" / "rho").is_file():
-        rho, source = _number(_read(folder, "0/rho", file).get("internalField")), \
-            f"{file}: fluid.case: {folder / '0/rho'}: internalField"
-        if rho is None:
-            raise SceneError(f"{source}: must be uniform (one density for the gas), e.g. 'internalField uniform 1.2;' "
-                             f"or 'rho 1.2;' in constant/transportProperties")
-    else:
-        raise SceneError(f"{where}: rho: missing, and no 0/rho: write the gas density, e.g. 'rho 1.2;' (kg/m^3)")
-    if rho is None or not (math.isfinite(rho) and rho > 0):
-        raise SceneError(f"{source}: must be a positive density in kg/m^3, got {props.get('rho', rho)!r}")
-    return rho
 
 
 def mesh_patches(folder: Path, file: str) -> tuple[str, dict]:
@@ -167,11 +147,14 @@ def check_decomposition(folder: Path, file: str, ranks: int) -> None:
 
 def check_case(folder: Path, file: str, ranks: int, energy: bool) -> None:
     """All the checks of the module doc (the files' presence is checked by the caller)."""
-    density(folder, file)
     props = _read(folder, "constant/transportProperties", file)
+    where = f"{file}: fluid.case: {folder / 'constant/transportProperties'}"
     if _number(props.get("nu")) is None:
-        raise SceneError(f"{file}: fluid.case: {folder / 'constant/transportProperties'}: nu: missing or not a "
-                         "number: write the kinematic viscosity, e.g. 'nu 1.5e-05;' (m^2/s)")
+        raise SceneError(f"{where}: nu: missing or not a number: write the kinematic viscosity, e.g. "
+                         "'nu 1.5e-05;' (m^2/s)")
+    if "rho" in props and _number(props["rho"]) is None:
+        raise SceneError(f"{where}: rho: must be a number, the gas density in kg/m^3 (e.g. 'rho 1.2;'), "
+                         f"got {props['rho']!r}")
     check_fields(folder, file, ("U", "p", "T") if energy else ("U", "p"))
     if ranks > 1:
         check_decomposition(folder, file, ranks)

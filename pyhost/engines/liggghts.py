@@ -175,6 +175,23 @@ class Liggghts:
                 os.environ[_ISOLATED] = saved
         self._watch()
 
+    def new_warnings(self) -> list[str]:
+        """LIGGGHTS' WARNING lines written to its screen log since the last call (rank 0's)."""
+        self.helper.collheat_flush(self.ptr)
+        try:
+            size = self.log.stat().st_size
+        except FileNotFoundError:
+            return []
+        start = getattr(self, "_screen_read", 0)
+        if size <= start:
+            return []
+        with open(self.log, "rb") as f:
+            f.seek(start)
+            text = f.read(size - start).decode(errors="replace")
+        complete = text.rfind("\n") + 1               # a line still being written waits for the next call
+        self._screen_read = start + len(text[:complete].encode(errors="replace"))
+        return [ln.strip() for ln in text[:complete].splitlines() if ln.startswith("WARNING")]
+
     def _watch(self) -> None:
         self.helper.collheat_watch_exit(self.ptr, str(self.log).encode())
         global _disarm_registered

@@ -37,8 +37,29 @@ LOCATE, ADVANCE, FIELDS, WRITE, STOP, TEMPERATURE = 1, 2, 3, 4, 5, 6
 TIMEOUT = float(os.environ.get("COLLHEAT_FLUID_TIMEOUT", 120.0))   # s, see the module doc
 
 
+def _divided_points() -> np.ndarray:
+    """Rows (weight, x, y, z) of points in the unit sphere (radius 1) for the ``divided``
+    void fraction: three shells of a third of the volume each, the inner one by its centre,
+    the middle by 6 points on the axes and the outer by 8 on the diagonals, each at the
+    radius that halves its shell's volume."""
+    axes = np.vstack([np.eye(3), -np.eye(3)])
+    diagonals = np.array([[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-1, 1)]) / np.sqrt(3)
+    rows = [[1 / 3, 0, 0, 0]]
+    rows += [[1 / 18, *(0.5 ** (1 / 3) * a)] for a in axes]
+    rows += [[1 / 24, *((5 / 6) ** (1 / 3) * a)] for a in diagonals]
+    return np.array(rows)
+
+
+DIVIDED = _divided_points()
+
+
 class FluidError(RuntimeError):
     """The fluid solver failed; the message ends with the tail of its log."""
+
+
+class FluidCaseError(ValueError):
+    """The solver refused the case's input before its first step (its exit code 2, e.g. a
+    boundary condition it cannot honour): bad input, with the tail of its log."""
 
 
 def _exchange(method):
@@ -92,6 +113,10 @@ class FluidSolver:
     ``nprocs``: MPI ranks (>1 decomposes the case first; the case needs
     system/decomposeParDict). ``drag``: name of a law in :mod:`plugins.drag`.
     ``alpha_min``: floor of the fluid volume fraction handed to the solver (-).
+    ``void_fraction``: how a particle's volume (and drag) goes to the cells: ``"centre"``, all
+    to the cell of its centre; ``"divided"``, spread over the cells its volume overlaps, by
+    the 15 points of ``DIVIDED`` (as CFDEM's divided model; for cells not much larger than
+    the particles, where the centre rule makes the fraction jump from cell to cell).
     ``timeout``: seconds the host waits for one answer of the solver.
     ``energy``: also solve the gas temperature (``collheatFoam -energy``: the case needs 0/T
     and ``Cp``, ``kappa`` in transportProperties); :meth:`advance` then takes the heat of
@@ -101,7 +126,8 @@ class FluidSolver:
     """
 
     def __init__(self, case: str | os.PathLike, *, nprocs: int = 1, drag: str = "gidaspow",
-                 alpha_min: float = 0.3, timeout: float = TIMEOUT, energy: bool = False):
+                 alpha_min: float = 0.3, timeout: float = TIMEOUT, energy: bool = False,
+                 void_fraction: str = "centre"):
         self.case = Path(case).resolve()
         if not (self.case / "system" / "controlDict").is_file():
             raise FluidError(f"{self.case} is not an OpenFOAM case (no system/controlDict)")
@@ -110,6 +136,9 @@ class FluidSolver:
         self.drag_law = drag_laws.get(drag)
         self.drag = drag
         self.nprocs, self.alpha_min, self.timeout = nprocs, alpha_min, timeout
+        if void_fraction not in ("centre", "divided"):
+            raise ValueError(f"void_fraction must be centre or divided, got {void_fraction!r}")
+        self.void_fraction = void_fraction
         props = FoamFile(self.case / "constant" / "transportProperties")
         self.nu = _value(props["nu"])
         self.rho = _value(props["rho"])
@@ -245,14 +274,21 @@ class FluidSolver:
         cell, u, gradp = self.locate(x)
         vp = np.pi * d**3 / 6.0
         ncells = len(self.cell_volumes)
-        solid = np.bincount(cell, weights=vp, minlength=ncells) / self.cell_volumes
+        if self.void_fraction == "divided" and len(x):
+            points = (x[:, None, :] + 0.5 * d[:, None, None] * DIVIDED[None, :, 1:]).reshape(-1, 3)
+            cells = self.locate(points, strict=False)[0].reshape(len(x), -1)
+            cells = np.where(cells >= 0, cells, cell[:, None])    # a point beyond a curved wall: the centre's
+            share = np.broadcast_to(DIVIDED[:, 0], cells.shape)
+        else:
+            cells, share = cell[:, None], np.ones((len(x), 1))
+        spread = lambda w: np.bincount(cells.ravel(), weights=(w[:, None] * share).ravel(), minlength=ncells)
+        solid = spread(vp) / self.cell_volumes
         alpha = np.maximum(1.0 - solid, self.alpha_min)
         slip = u - v
         self.cell, self.slip = cell, np.linalg.norm(slip, axis=1)
-        k = self.drag_law(alpha[cell], self.slip, d, self.rho, self.nu)
-        ksum = np.bincount(cell, weights=k, minlength=ncells)
-        kv = np.stack([np.bincount(cell, weights=k * v[:, i], minlength=ncells)
-                       for i in range(3)], axis=1)
+        k = self.drag_law(np.sum(alpha[cells] * share, axis=1), self.slip, d, self.rho, self.nu)
+        ksum = spread(k)
+        kv = np.stack([spread(k * v[:, i]) for i in range(3)], axis=1)
         self._alpha = alpha
         self._ksl = ksum / self.cell_volumes
         self._us = np.divide(kv, ksum[:, None], out=np.zeros(kv.shape), where=ksum[:, None] > 0)   # float
@@ -260,10 +296,11 @@ class FluidSolver:
         return k[:, None] * slip - (vp * self.rho)[:, None] * gradp
 
     @_exchange
-    def locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def locate(self, x: np.ndarray, strict: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Cell of each position (global index over ranks), fluid velocity (m/s) and kinematic
         pressure gradient (m/s^2) there, interpolated as controlDict's
-        ``particleInterpolation`` says (default ``cell``). ValueError if a point is outside."""
+        ``particleInterpolation`` says (default ``cell``). ValueError if a point is outside
+        (``strict``), else cell -1 there."""
         x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 3)
         n = len(x)
         request = np.int32(LOCATE).tobytes() + np.int32(n).tobytes() + x.tobytes()
@@ -278,7 +315,7 @@ class FluidSolver:
             mine = (c >= 0) & (cell < 0)
             cell[mine] = c[mine] + self.offsets[rank]
             u[mine], gradp[mine] = ur[mine], gr[mine]
-        if np.any(cell < 0):
+        if strict and np.any(cell < 0):
             lost = np.flatnonzero(cell < 0)
             raise ValueError(f"{len(lost)} point(s) outside the fluid mesh, e.g. index {lost[0]} "
                              f"at {x[lost[0]].tolist()} m")
@@ -357,7 +394,7 @@ class FluidSolver:
         return self.time
 
     # -- pipes ------------------------------------------------------------------------
-    def _failed(self, what: str, waited: float | None = None) -> FluidError:
+    def _failed(self, what: str, waited: float | None = None) -> FluidError | FluidCaseError:
         """The error for a solver that ended while ``what``, or (``waited`` seconds given)
         one still alive that did not answer in time, which is then ended."""
         if waited is not None and self.proc.poll() is None:
@@ -372,6 +409,9 @@ class FluidSolver:
         except subprocess.TimeoutExpired:
             self._kill()
         rc = self.proc.returncode
+        if rc == 2:
+            return FluidCaseError(f"{self.case.name}: the fluid solver refused the case; end of "
+                                  f"{self.log}:\n{log_tail(self.log)}")
         how = f"exit code {rc}"
         if rc < 0:
             how = f"killed by {signal.Signals(-rc).name}"

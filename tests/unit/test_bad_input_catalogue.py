@@ -254,11 +254,11 @@ POLYMESH = ("FoamFile { version 2.0; format ascii; class polyBoundaryMesh; objec
             + "".join(f"{n} {{ type wall; inGroups List<word> 1(wall); nFaces 1; startFace {k}; }}\n"
                       for k, n in enumerate(("xlo", "xhi", "ylo", "yhi", "bottom", "zhi"))) + ")\n")
 FLUID_CASES = {   # id: (changes of the valid user case, words the one-line message must hold)
-    "rho nowhere": ([foam_text("0/rho", None)], ["transportProperties: rho: missing, and no 0/rho"]),
+    "rho nowhere": ([foam_text("0/rho", None)], ["transportProperties has no rho and there is no 0/rho"]),
     "0/rho not uniform": ([foam_edit("0/rho", "internalField", np.full(8, 1.2))],
-                          ["0/rho: internalField: must be uniform"]),
-    "0/rho negative": ([foam_edit("0/rho", "internalField", -1.0)], ["0/rho: internalField", "positive"]),
-    "rho a word": ([foam_edit("constant/transportProperties", "rho", "air")], ["transportProperties: rho", "'air'"]),
+                          ["0/rho: internalField: the gas density must be one uniform"]),
+    "0/rho negative": ([foam_edit("0/rho", "internalField", -1.0)], ["0/rho: internalField", "uniform positive"]),
+    "rho a word": ([foam_edit("constant/transportProperties", "rho", "air")], ["transportProperties: rho: must be a number", "'air'"]),
     "nu missing": ([foam_edit("constant/transportProperties", "nu")], ["transportProperties: nu: missing"]),
     "0/U patch misnamed": ([foam_rename("0/U", "zhi", "top")],
                            ["0/U: boundaryField", "patch 'zhi'", "system/blockMeshDict", "instead of 'top'"]),

@@ -40,6 +40,7 @@ Description
 #include "pimpleControl.H"
 #include "fvOptions.H"
 #include "interpolation.H"
+#include "fixedFluxPressureFvPatchScalarField.H"
 #include <cstdio>
 
 int main(int argc, char *argv[])

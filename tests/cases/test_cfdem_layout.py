@@ -1,0 +1,157 @@
+"""A CFD-DEM case laid out and written as CFDEMcoupling's tutorials are (our own files, after
+settlingTestMPI): case.toml inside the OpenFOAM folder (``case = "."``), the DEM script in
+../DEM ending in ``run 0`` that the coupling drives, rho in 0/rho, pressure zeroGradient at
+the walls, no [materials].dem table (the script sets the DEM values). One sphere settles
+at the Di Felice terminal speed."""
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from foamlib import FoamFile
+from scipy.optimize import brentq
+
+from plugins.drag import get as drag_law
+from pyhost.engines.fluid_case import box_case
+
+pytestmark = pytest.mark.engines
+ROOT = Path(__file__).resolve().parents[2]
+D, RHO_P, RHO, NU = 1e-4, 3000.0, 10.0, 1e-5       # m, kg/m^3, kg/m^3, m^2/s (settlingTestMPI's)
+
+SCRIPT = """# one sphere released in a closed column, coupled every 100 steps (a CFDEM-style run script)
+log             ../DEM/log.liggghts
+atom_style      granular
+atom_modify     map array sort 0 0
+communicate     single vel yes
+boundary        f f f
+newton          off
+units           si
+region          reg block 0 0.02 0 0.02 0 0.08 units box
+create_box      1 reg
+neighbor        0.0002 bin
+neigh_modify    delay 0
+fix         m1 all property/global youngsModulus peratomtype 5.e6
+fix         m2 all property/global poissonsRatio peratomtype 0.45
+fix         m3 all property/global coefficientRestitution peratomtypepair 1 0.3
+fix         m4 all property/global coefficientFriction peratomtypepair 1 0.5
+pair_style  gran model hertz tangential history
+pair_coeff  * *
+timestep    0.00001
+fix         gravi all gravity 9.81 vector 0.0 0.0 -1.0
+fix         zwalls1 all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+create_atoms    1 single 0.01 0.01 0.07 units box
+set             group all diameter {d} density {rho_p}
+variable    vz equal vz[1]
+variable    time equal step*dt
+fix         extra all print 100 "${{time}} ${{vz}}" file ../DEM/post/velocity.txt screen no
+fix         integr all nve/sphere
+run     0
+run     0 upto
+"""
+
+CASE_TOML = """[dem]
+script = "../DEM/in.liggghts_run"
+
+[effects]
+fluid = true
+
+[fluid]
+case = "."
+drag = "difelice"
+
+[time]
+couple_every = 100
+{time}
+[materials.beads]
+types = [1]
+density = 3000.0
+youngs_modulus = 63e9
+poisson_ratio = 0.25
+yield_stress = 500e6
+heat_capacity = 840.0
+conductivity = 1.0
+{dem}
+"""
+
+
+def cfdem_case(root: Path, end: float = 0.1, time: str = "", dem: str = "") -> Path:
+    """The two folders CFD/ and DEM/ as a CFDEM tutorial has them; returns CFD/."""
+    cfd, dem_dir = root / "CFD", root / "DEM"
+    walls = {f: "wall" for f in ("xlo", "xhi", "ylo", "yhi", "zlo")}
+    box_case(cfd, lo=(0, 0, 0), hi=(0.02, 0.02, 0.08), cells=(2, 2, 8), boundaries={**walls, "zhi": "outlet"},
+             rho=RHO, nu=NU, dt=1e-3)
+    props = FoamFile(cfd / "constant" / "transportProperties")
+    del props["rho"]                                          # CFDEM keeps it in 0/rho
+    rho = FoamFile(cfd / "0" / "rho")
+    rho.class_, rho.object_ = "volScalarField", "rho"
+    rho.update({"dimensions": FoamFile.DimensionSet(mass=1, length=-3), "internalField": RHO,
+                "boundaryField": {".*": {"type": "zeroGradient"}}})
+    p = FoamFile(cfd / "0" / "p")
+    for face in walls:
+        p["boundaryField"][face] = {"type": "zeroGradient"}
+    FoamFile(cfd / "system" / "controlDict")["endTime"] = end
+    (dem_dir / "post").mkdir(parents=True)
+    (dem_dir / "in.liggghts_run").write_text(SCRIPT.format(d=D, rho_p=RHO_P))
+    (cfd / "case.toml").write_text(CASE_TOML.format(time=time, dem=dem))
+    return cfd
+
+
+def run(cfd: Path, *extra):
+    return subprocess.run([sys.executable, "-m", "pyhost", "run", str(cfd), *extra], capture_output=True,
+                          text=True, cwd=ROOT, timeout=600)
+
+
+def velocities(cfd: Path) -> np.ndarray:
+    return np.loadtxt(cfd.parent / "DEM" / "post" / "velocity.txt", comments="#", ndmin=2)
+
+
+def terminal_speed() -> float:
+    law = drag_law("difelice")
+    weight = (RHO_P - RHO) * math.pi * D**3 / 6 * 9.81
+    return brentq(lambda v: float(law(1.0, v, D, RHO, NU)) * v - weight, 1e-6, 10.0)
+
+
+def test_cfdem_layout_settles_at_the_drag_law_speed(tmp_path):
+    """Exit 0; the final ``run 0`` lasts the controlDict's endTime (0.1 s = 10,000 steps);
+    the sphere falls at the Di Felice terminal speed within 1 % (its relaxation time is
+    0.017 s); rho came from 0/rho; the output inside the case holds no copy of itself."""
+    cfd = cfdem_case(tmp_path)
+    r = run(cfd)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "which the coupling drives: 0.1 s (10000 steps" in r.stdout
+    t, vz = velocities(cfd).T
+    assert t[-1] == pytest.approx(0.1)
+    print(f"settling speed {-vz[-1]:.6f} m/s, Di Felice {terminal_speed():.6f} m/s")
+    assert -vz[-1] == pytest.approx(terminal_speed(), rel=0.01)
+    copied = cfd / "output" / "fluid"
+    assert (copied / "case.toml").exists() and not (copied / "output").exists()
+    assert float(FoamFile(copied / "constant" / "transportProperties")["rho"].value) == RHO
+
+
+def test_time_end_and_test_cut_the_driven_run(tmp_path):
+    """[time] end sets the driven run's length; --test cuts it to a tenth, and cuts the
+    script's first run as well."""
+    cfd = cfdem_case(tmp_path, time="end = 0.05")
+    r = run(cfd, "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert velocities(cfd)[-1, 0] == pytest.approx(0.005)
+
+
+def test_dem_table_that_disagrees_with_the_script_is_refused(tmp_path):
+    cfd = cfdem_case(tmp_path, dem="dem = { youngs_modulus = 1e7, restitution = 0.3 }")
+    r = run(cfd)
+    assert r.returncode == 2
+    assert "materials.beads.dem.youngs_modulus = 1e+07 differs from the script's youngsModulus 5e+06" in r.stderr
+
+
+def test_a_dry_script_whose_runs_simulate_nothing_is_refused(tmp_path):
+    """Without a fluid nothing drives a 'run 0': exit 2 naming the script's last run, where
+    the host used to end 'completed' after 0 s."""
+    cfd = cfdem_case(tmp_path)
+    toml = (cfd / "case.toml").read_text().replace("fluid = true", "fluid = false")
+    (cfd / "case.toml").write_text(toml.replace('[fluid]\ncase = "."\ndrag = "difelice"\n', ""))
+    r = run(cfd)
+    assert r.returncode == 2, r.stdout[-2000:] + r.stderr[-2000:]
+    assert "the script's runs simulate no step" in r.stderr and "in.liggghts_run:" in r.stderr

@@ -1,0 +1,137 @@
+"""Users' scripts the host used to run to a wrong or silent end: particles that grow (fix
+adapt, as Debian's packing tutorial), a fix heat/gran defined after the first run (as CFDEM's
+packedBedTemp), materials of types the script does not create, particles at 0 K."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.engines
+ROOT = Path(__file__).resolve().parents[2]
+
+HEAD = """atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+region box block 0 0.02 0 0.02 0 0.02 units box
+create_box {types} box
+neighbor 0.0005 bin
+neigh_modify delay 0
+fix m1 all property/global youngsModulus peratomtype {E}
+fix m2 all property/global poissonsRatio peratomtype {nu}
+fix m3 all property/global coefficientRestitution peratomtypepair {types} {e}
+fix m4 all property/global coefficientFriction peratomtypepair {types} {mu}
+pair_style gran model hertz tangential history
+pair_coeff * *
+timestep 1e-5
+fix walls all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+fix walls2 all wall/gran model hertz tangential history primitive type 1 zplane 0.02
+region fill block 0.002 0.018 0.002 0.018 0.002 0.018 units box
+fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
+fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 0 insert_every once overlapcheck yes all_in yes particles_in_region 40 region fill
+fix integr all nve/sphere
+"""
+
+GROW = """run 1
+unfix ins
+compute rad all property/atom radius
+variable dgrown atom 2.0*1.0001*c_rad
+fix grow all adapt 20 atom diameter v_dgrown
+run 2000
+unfix grow
+run 500
+"""
+
+
+def header(types=1):
+    n = types * types
+    return HEAD.format(types=types, E=" ".join(["5e6"] * types), nu=" ".join(["0.3"] * types),
+                       e=" ".join(["0.5"] * n), mu=" ".join(["0.5"] * n))
+
+
+def toml(types="[1]", temperature="temperature = 300.0"):
+    return f"""[dem]
+script = "in.run"
+[effects]
+contact_heat = "A"
+[materials.glass]
+types = {types}
+{temperature}
+density = 2500.0
+youngs_modulus = 63e9
+poisson_ratio = 0.25
+yield_stress = 500e6
+heat_capacity = 840.0
+conductivity = 1.0
+[output]
+vtk = false
+pictures = false
+"""
+
+
+def run(tmp_path, script, case_toml):
+    (tmp_path / "in.run").write_text(script)
+    (tmp_path / "case.toml").write_text(case_toml)
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=600)
+    summary = tmp_path / "out" / "summary.json"
+    return r, json.loads(summary.read_text()) if summary.exists() else None
+
+
+def test_growing_particles_enter_the_balance_as_a_mass_change(tmp_path):
+    """40 spheres grow by 0.01 % of their diameter every 20 steps over 2000 steps (mass x 1.03)
+    at one temperature: the balance closes to 1e-12 with the named term energy_mass_change =
+    c T dm, where it used to end 'completed' with an error of the size of the growth."""
+    r, s = run(tmp_path, header() + GROW, toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    mass0 = 40 * 2500.0 * 4 / 3 * 3.141592653589793 * 0.001**3
+    growth = s["sum_mcT_end"] / s["energy_in"] - 1                  # inserted in the first run
+    print(f"m c T grew by {growth:.4%}; energy_mass_change {s['energy_mass_change']:.6g} J")
+    assert s["energy_in"] == pytest.approx(840.0 * 300.0 * mass0, rel=1e-12)
+    assert growth == pytest.approx(1.0001**303 - 1, rel=1e-3)       # d x 1.0001 at steps 0, 20, ..., 2000
+    assert s["energy_mass_change"] == pytest.approx(s["sum_mcT_end"] - s["energy_in"], rel=1e-9)
+    assert abs(s["energy_balance_error"]) < 1e-12
+
+
+def test_heat_gran_after_the_first_run_has_its_capacities_checked(tmp_path):
+    """fix heat/gran defined after 'run 0' with a thermalCapacity other than the material's:
+    exit 2 naming both values (the check used to run only at the first run)."""
+    late = """run 0
+fix ftco all property/global thermalConductivity peratomtype 5.
+fix ftca all property/global thermalCapacity peratomtype 0.1
+fix heattransfer all heat/gran initial_temperature 600.
+run 200
+"""
+    r, _ = run(tmp_path, header() + late, toml(temperature=""))
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "the script's thermalCapacity 0.1 differs from materials.glass.heat_capacity 840" in r.stderr
+
+
+def test_material_of_a_type_the_script_does_not_create_is_refused_before_the_engines(tmp_path):
+    r, s = run(tmp_path, header() + "run 100\n", toml(types="[1, 2]"))
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "materials.glass.types: atom type 2 does not exist: " in r.stderr and "in.run:8 creates 1 atom type" in r.stderr
+    assert s is None and "host adds to the script" not in r.stdout     # no engine time spent
+
+
+def test_particles_at_zero_kelvin_are_refused(tmp_path):
+    """No fix heat/gran and no material temperature: the particles would start at 0 K."""
+    r, _ = run(tmp_path, header() + "run 100\n", toml(temperature=""))
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "starts at 0 K: temperatures must be above 0 K; give materials.glass.temperature" in r.stderr
+
+
+def test_liggghts_warnings_are_shown_once(tmp_path):
+    """An insertion that cannot place all it is asked for warns in LIGGGHTS' screen log; the
+    host shows the warning on its own output, once."""
+    crowded = header().replace("particles_in_region 40", "particles_in_region 5000") + "run 100\nrun 100\n"
+    r, _ = run(tmp_path, crowded, toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    shown = [ln for ln in r.stdout.splitlines() if ln.startswith("LIGGGHTS WARNING") and "insert" in ln.lower()]
+    print(shown)
+    assert len(shown) == 1 and "each warning is shown once" in shown[0]

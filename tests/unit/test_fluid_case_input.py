@@ -1,0 +1,46 @@
+"""A user's OpenFOAM case as CFDEM keeps it: the gas density from transportProperties or a
+uniform 0/rho, else a refusal naming the file (exit 2), before any engine starts."""
+import numpy as np
+import pytest
+from foamlib import FoamFile
+
+from pyhost.engines.fluid_case import box_case, case_density
+
+WALLS = {f: "wall" for f in ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")}
+
+
+@pytest.fixture
+def case(tmp_path):
+    folder = box_case(tmp_path / "fluid", lo=(0, 0, 0), hi=(1, 1, 1), cells=(1, 1, 1), boundaries=WALLS,
+                      rho=1.5, nu=1e-5)
+    return folder
+
+
+def rho_field(case, value):
+    f = FoamFile(case / "0" / "rho")
+    f.class_, f.object_ = "volScalarField", "rho"
+    f.update({"dimensions": FoamFile.DimensionSet(mass=1, length=-3), "internalField": value,
+              "boundaryField": {".*": {"type": "zeroGradient"}}})
+
+
+def test_density_from_transport_properties(case):
+    assert case_density(case) == (1.5, "constant/transportProperties: rho")
+
+
+def test_density_from_0_rho_when_transport_properties_has_none(case):
+    del FoamFile(case / "constant" / "transportProperties")["rho"]
+    rho_field(case, 10.0)
+    assert case_density(case) == (10.0, "0/rho: internalField")
+
+
+def test_no_density_anywhere_names_both_places(case):
+    del FoamFile(case / "constant" / "transportProperties")["rho"]
+    with pytest.raises(ValueError, match=r"transportProperties has no rho and there is no 0/rho"):
+        case_density(case)
+
+
+def test_non_uniform_0_rho_is_refused(case):
+    del FoamFile(case / "constant" / "transportProperties")["rho"]
+    rho_field(case, np.array([1.0]))
+    with pytest.raises(ValueError, match=r"0/rho: internalField: the gas density must be one uniform"):
+        case_density(case)
