@@ -101,9 +101,14 @@ def _mesh(case: Path, source: Path, file: str) -> None:
     try:
         run_utility(case, "blockMesh")
     except FluidError:
-        log = (case / "log.blockMesh").read_text(errors="replace").splitlines()
-        fatal = next((k for k, line in enumerate(log) if "FOAM FATAL" in line), len(log) - 6)
-        words = "; ".join(line.strip() for line in log[fatal + 1:fatal + 6] if line.strip())
+        log = [line.strip() for line in (case / "log.blockMesh").read_text(errors="replace").splitlines()]
+        fatal = next((k for k, line in enumerate(log) if "FOAM FATAL" in line), len(log) - 2)
+        said = []
+        for line in log[fatal + 1:]:
+            if line.startswith(("From ", "FOAM aborting", "FOAM exiting", "#0")):
+                break
+            said += [line] if line else []
+        words = "; ".join(said)
         raise SceneError(f"{file}: fluid.case: {source / 'system/blockMeshDict'}: blockMesh refuses it: "
                          f"{words}") from None
 

@@ -44,3 +44,22 @@ def test_non_uniform_0_rho_is_refused(case):
     rho_field(case, np.array([1.0]))
     with pytest.raises(ValueError, match=r"0/rho: internalField: the gas density must be one uniform"):
         case_density(case)
+
+
+def test_copy_of_a_case_holding_runs_leaves_them_out(case):
+    """case = ".": the copy (OUT/fluid inside the case) holds the case's own files only: not
+    itself, not an earlier run's output written with another --out (scene.json), not the
+    solver's later times or processor folders."""
+    import shutil
+
+    from pyhost.commands.run import _case_copy_filter
+    (case / "case.toml").write_text("")
+    for old in ("old-run", "output"):
+        (case / old / "fluid").mkdir(parents=True)
+        (case / old / "scene.json").write_text("{}")
+    (case / "0.5").mkdir()
+    (case / "processor0").mkdir()
+    copy = case / "output" / "fluid"
+    shutil.rmtree(copy)
+    shutil.copytree(case, copy, ignore=_case_copy_filter(copy))
+    assert sorted(p.name for p in copy.iterdir()) == ["0", "case.toml", "constant", "system"]
