@@ -3,41 +3,19 @@
 where the run used to end as a failed simulation (exit 3)."""
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
+import tomli_w
 
 from pyhost.engines.fluid_case import FACES, box_case
 
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
 
-SCENE = """[effects]
-fluid = true
-[fluid]
-case = "fluid"
-[materials.steel]
-density = 7800.0
-youngs_modulus = 210e9
-poisson_ratio = 0.3
-yield_stress = 300e6
-heat_capacity = 470.0
-conductivity = 45.0
-dem = { youngs_modulus = 2e8, restitution = 0.9 }
-[[particles]]
-material = "steel"
-count = 1
-radius = 1e-3
-temperature = 300.0
-positions = [[0.5, 0.5, 0.5]]
-[domain]
-box = [0.0, 1.0, 0.0, 1.0, 0.0, 1.0]
-[time]
-dem_step = 2e-6
-end = 1e-3
-[output]
-pictures = false
-"""
+BASE = tomllib.loads((ROOT / "cases" / "two-particles" / "case.toml").read_text())
+SCENE = dict(BASE, effects={"fluid": True}, fluid={"case": "fluid"}, output={"pictures": False})
 
 
 def test_blockmesh_refusal_is_bad_input(tmp_path):
@@ -50,7 +28,7 @@ def test_blockmesh_refusal_is_bad_input(tmp_path):
     mesh = fluid / "system" / "blockMeshDict"
     mesh.write_text(mesh.read_text().replace("(0 4 7 3)", "(0 4 6 3)"))
     assert "0 4 6 3" in mesh.read_text()
-    (case / "case.toml").write_text(SCENE)
+    (case / "case.toml").write_text(tomli_w.dumps(SCENE))
     r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--out", str(tmp_path / "out")],
                        capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert r.returncode == 2, r.stdout[-2000:] + r.stderr[-2000:]
