@@ -170,7 +170,11 @@ class Fluid:
                                      "with its own mesh and boundary conditions (supported: docs/fluid-cases.md). "
                                      "Its transportProperties give nu and rho (or a uniform 0/rho), its "
                                      "constant/g the gravity, which acts on the gas: the keys density, "
-                                     "viscosity, inlet_*, plenum, cells and sides are then unused")
+                                     "viscosity, inlet_*, plenum, cells and sides are then unused. Checked "
+                                     "before any engine: each mesh patch has its entry in 0/U and 0/p, "
+                                     "decomposeParDict has fluid.ranks subdomains, the mesh files read "
+                                     "(docs/exit-codes.md). Copied to OUT/fluid without run outputs, time "
+                                     "folders other than 0 and processor folders")
     density: float = spec(">0", 1.2, "[kg/m^3]")
     viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
     inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the inlet (fluid z lo) [m/s]")
