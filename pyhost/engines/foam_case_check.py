@@ -118,7 +118,8 @@ def check_fields(folder: Path, file: str, fields) -> None:
             continue            # entries from another file: left to OpenFOAM
         for patch, groups in patches.items():
             if not _covered(patch, groups, keys):
-                unused = [k for k in keys if k not in patches and not k.startswith(("#", '"'))]
+                named = set(patches).union(*patches.values())
+                unused = [k for k in keys if k not in named and not k.startswith(("#", '"'))]
                 raise SceneError(f"{where}: no entry for the mesh's patch {patch!r} (patches of {source}: "
                                  f"{', '.join(patches)}; entries: {', '.join(keys) or 'none'}): name it "
                                  f"'{patch} {{ type ...; }}'"
