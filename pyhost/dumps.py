@@ -123,6 +123,46 @@ class Script:
     computes: dict                  # id -> Compute (local styles only)
     mesh_wall_fixes: tuple          # ids of wall/gran fixes with meshes, in script order
     warnings: tuple = ()
+    box: np.ndarray | None = None   # (3, 2) lo hi [m] of its create_box, None if unknown
+    heat_gran: tuple = ()           # ids of its fix heat/gran
+    planes: dict = field(default_factory=dict)     # primitive plane wall fix id -> (axis 0-2, position m)
+
+
+SETUP_COMMANDS = ("units", "dimension", "boundary", "atom_style", "atom_modify", "newton", "communicate",
+                  "lattice", "variable", "region", "create_box", "timestep")
+"""What post asks LIGGGHTS to run of a script to learn its time step and box as LIGGGHTS
+resolves them (variables, ${...}): set-up only, no particles, no runs, no files written."""
+
+
+def resolve_setup(lines: list[tuple[int, str]], path: Path) -> tuple[float | None, np.ndarray | None, str | None]:
+    """Time step [s] and box (3, 2) [m] of a script's set-up commands ``lines`` (line
+    number, text) as LIGGGHTS itself evaluates them: the ``liggghts`` program runs them in a
+    scratch folder and prints the values (a process of its own: its VTK and pyvista's do not
+    share one). (None, None, why) when LIGGGHTS refuses one of them."""
+    import subprocess
+    import tempfile
+
+    timestep = [t.split(None, 1)[1] for _, t in lines if t.split()[0] == "timestep"]
+    boxed = any(t.split()[0] == "create_box" for _, t in lines)
+    body = [t for _, t in lines if t.split()[0] != "timestep"]
+    if timestep:
+        body.append(f'print "COLLHEAT_DT {timestep[-1]}"')
+    if boxed:
+        names = [f"{a}{e}" for a in "xyz" for e in ("lo", "hi")]
+        body += [f"variable collheat_{n} equal {n}" for n in names]
+        body.append('print "COLLHEAT_BOX ' + " ".join(f"${{collheat_{n}}}" for n in names) + '"')
+    with tempfile.TemporaryDirectory(prefix="collheat-setup-") as tmp:
+        (Path(tmp) / "in.setup").write_text("\n".join(body) + "\n")
+        r = subprocess.run(["liggghts", "-in", "in.setup", "-screen", "screen.txt", "-log", "none"], cwd=tmp,
+                           capture_output=True, text=True, timeout=120)
+        screen = (Path(tmp) / "screen.txt").read_text(errors="replace") if (Path(tmp) / "screen.txt").exists() else ""
+    errors = [ln for ln in screen.splitlines() if ln.startswith("ERROR")]
+    if r.returncode or errors:
+        return None, None, f"{path}: {(errors or [r.stdout.strip() or 'no message'])[-1]}"
+    values = {ln.split()[0]: ln.split()[1:] for ln in screen.splitlines() if ln.startswith("COLLHEAT_")}
+    dt = float(values["COLLHEAT_DT"][0]) if "COLLHEAT_DT" in values else None
+    box = np.array(values["COLLHEAT_BOX"], float).reshape(3, 2) if "COLLHEAT_BOX" in values else None
+    return dt, box, None
 
 
 def read_script(path) -> Script:
@@ -134,18 +174,29 @@ def read_script(path) -> Script:
     except OSError as exc:
         raise ValueError(f"{path}: cannot read the LIGGGHTS script: {exc.strerror}") from None
     timestep, computes, walls, warnings = None, {}, [], []
+    setup, heat_gran, planes, literal = [], [], {}, True
     text = re.sub(r"&[ \t]*\n", " ", text)
     for number, line in enumerate(text.splitlines(), start=1):
         words = line.split("#")[0].split()
         if not words:
             continue
         where = f"{path}: line {number}: "
+        if words[0] in SETUP_COMMANDS:
+            setup.append((number, " ".join(words)))
         if words[0] == "timestep" and len(words) > 1:
             try:
                 timestep = float(words[1])
             except ValueError:
-                timestep = None
-                warnings.append(f"{where}timestep {words[1]!r} is not a number: give --dt")
+                timestep, literal = None, False
+        elif words[0] == "fix" and len(words) > 3 and words[3] == "heat/gran":
+            heat_gran.append(words[1])
+        elif words[0] == "fix" and len(words) > 5 and words[3] == "wall/gran" and "primitive" in words:
+            kind = next((w for w in words if w in ("xplane", "yplane", "zplane")), None)
+            at = words.index(kind) + 1 if kind else len(words)
+            try:
+                planes[words[1]] = ("xyz".index(kind[0]), float(words[at]))
+            except (TypeError, ValueError, IndexError):
+                pass                    # a cylinder or a $variable: post places planes only
         elif words[0] == "compute" and len(words) > 3 and words[3] in LOCAL_STYLES:
             c = parse_compute(line, where)
             computes[c.id] = c
@@ -153,7 +204,15 @@ def read_script(path) -> Script:
             walls.append(words[1])
         elif words[0] == "include":
             warnings.append(f"{where}include {' '.join(words[1:])} not followed")
-    return Script(timestep, computes, tuple(walls), tuple(warnings))
+    box = None
+    if not literal or any(t.split()[0] == "create_box" for _, t in setup):
+        dt, box, why = resolve_setup(setup, path)
+        if why:
+            warnings.append(f"LIGGGHTS could not run the script's set-up ({why}): its time step and box are unknown; "
+                            "give --dt")
+        elif not literal:
+            timestep = dt
+    return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), planes)
 
 
 @dataclass(frozen=True, eq=False)
@@ -270,10 +329,14 @@ VTK_SUFFIXES = (".vtk", ".vtp", ".vtu")
 
 
 def expand(paths) -> list:
-    """Paths with shell wildcards expanded (for quoted ``'post/dump.*'``)."""
+    """Paths with shell wildcards expanded (for quoted ``'post/dump.*'``). A wildcard skips
+    the ``*boundingBox*.vtk`` files LIGGGHTS' custom/vtk writes beside each frame (they hold
+    the box only: ``heatGran_*.vtk`` matches them too)."""
     out = []
     for p in map(str, paths):
         hits = sorted(glob.glob(p)) if glob.has_magic(p) else [p]
+        if glob.has_magic(p):
+            hits = [h for h in hits if not (Path(h).suffix == ".vtk" and "boundingBox" in Path(h).name)]
         if not hits:
             raise DumpError(p, None, 0, "no file matches")
         for h in hits:

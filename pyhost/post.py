@@ -147,6 +147,7 @@ class Post:
         if self.dt is None:
             raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
         self.warnings = list(script.warnings) if script else []
+        self.unplaced = set()            # scene walls whose primitive plane post cannot place (warned)
         self.particles = Particles()
         self.summary = dict(frames=0, particles=0, collisions=dict(particle_particle=0, particle_wall=0),
                             heat_J={m: 0.0 for m in self.models}, warnings=self.warnings, complete=False)
@@ -179,11 +180,15 @@ class Post:
         positions when there are no contact dumps."""
         found, first = Found(), FirstAppearances()
         walls = [(k, w.plane) for k, w in enumerate(self.scene.walls) if w.plane]
+        primitive = {}                  # scene wall index -> (axis, position) of a script's primitive plane
         if not self.contacts:
-            for w in self.scene.walls:
-                if w.fix:
-                    self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps (wall/gran/local); "
-                                         "without them it is ignored")
+            planes = self.script.planes if self.script else {}
+            for k, w in enumerate(self.scene.walls):
+                if w.fix in planes:
+                    primitive[k] = planes[w.fix]
+                elif w.fix:
+                    self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps (wall/gran/local), "
+                                         "or --script when it is a primitive plane; without them it is ignored")
         steps, last = [], None
         for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
             ids, types = f["id"].astype(np.int64), f["type"].astype(int)
@@ -191,26 +196,49 @@ class Post:
             if unknown:
                 raise ValueError(f"{f.file}: timestep {f.step}: atom type {unknown[0]} is in no material of "
                                  f"{self.scene.path} (materials.NAME.types)")
-            temp = f["f_Temp"] if "f_Temp" in f else None
-            self.particles.add(ids, types, f["radius"], temp)
+            column = next((c for c in ("f_Temp", *(f"f_{h}" for h in (self.script.heat_gran if self.script else ())))
+                           if c in f), None)
+            self.particles.add(ids, types, f["radius"], f[column] if column else None)
             steps.append(f.step)
             last = f
             if not self.contacts:
-                self.position_contacts(f, ids, walls, found, first, steps)
+                self.position_contacts(f, ids, walls + self.box_faces(f, primitive), found, first, steps)
         self.summary["frames"] = len(steps)
         self.summary["particles"] = len(last) if last is not None else 0
         self.dump_steps = np.diff(steps).min() if len(steps) > 1 else None
         self.interval = self.dump_steps
         return found
 
+    def frame_box(self, f):
+        """The frame's box (3, 2) [m]; a VTK dump has none: the script's (``--script``)."""
+        return f.box if f.box is not None else (self.script.box if self.script else None)
+
+    def box_faces(self, f, primitive) -> list:
+        """(scene wall index, box face) of the script's primitive plane walls: a plane at a face
+        of the box is that face; one inside the box is not placed (warned once)."""
+        box, faces = self.frame_box(f), []
+        for k, (axis, position) in primitive.items():
+            if box is None:
+                continue
+            side = [abs(position - box[axis][e]) <= 1e-9 * max(1.0, abs(np.ptp(box[axis]))) for e in (0, 1)]
+            if any(side):
+                faces.append((k, "xyz"[axis] + ("lo" if side[0] else "hi")))
+            elif k not in self.unplaced:
+                self.unplaced.add(k)
+                self.warnings.append(f"wall fix {self.scene.walls[k].fix}: a plane at {position:g} m inside the box "
+                                     "is not placed by post; give --contacts dumps")
+        return faces
+
     def position_contacts(self, f, ids, walls, found, first, steps) -> None:
         if not len(f):
             first.new(np.empty(0, np.int64))
             return
-        if walls and f.box is None:
-            raise ValueError(f"{f.file}: a VTK dump has no box, so plane walls cannot be placed: use text dumps")
+        box = self.frame_box(f)
+        if walls and box is None:
+            raise ValueError(f"{f.file}: a VTK dump has no box, so plane walls cannot be placed: give --script "
+                             "(its create_box), or use text dumps")
         x = f.positions()
-        box = f.box if f.box is not None else np.stack([x.min(0) - 1.0, x.max(0) + 1.0], axis=1)
+        box = box if box is not None else np.stack([x.min(0) - 1.0, x.max(0) + 1.0], axis=1)
         c = find_contacts(x, f.vector("v"), f["radius"], box.ravel(), f.periodic, [p for _, p in walls])
         wall = c.j >= WALL_BASE
         j = ids[np.where(wall, 0, c.j)]

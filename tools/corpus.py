@@ -1,0 +1,319 @@
+#!/usr/bin/env python3
+"""Run public tutorials nobody here wrote through the host, as a user would, and check
+their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI and packedBedTemp, and
+Debian's liggghts-doc tutorials (packing, heatTransfer_1, chute_wear).
+
+The tutorials are not part of this repository (their licences are theirs, and fetched
+content is never committed): point ``--cfdem`` at a CFDEMcoupling-PUBLIC checkout; Debian's
+tutorials come with ``liggghts-doc`` (installed by tools/setup_engines.sh). Each tutorial is
+copied into ``--work`` (default /tmp/collheat-corpus), gets the case.toml written below and
+only the changes listed beside it (docs/tutorials.md says why a user cannot avoid them),
+then runs with ``python -m pyhost run``. A table of each run's exit code, wall time and
+physics checks (value, reference, tolerance) is printed; the exit code is 1 if any check
+fails.
+
+    .venv/bin/python tools/corpus.py --cfdem ~/CFDEMcoupling-PUBLIC            # all
+    .venv/bin/python tools/corpus.py --cfdem ... --only settlingTestMPI --test   # smoke
+
+Timings are wall clock on whatever else the machine runs: compare ratios from one run.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import re
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import brentq
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from plugins.drag import get as drag_law  # noqa: E402
+from pyhost.fluidization import ergun_pressure_drop  # noqa: E402
+
+LIGGGHTS_DOC = Path("/usr/share/doc/liggghts/examples/LIGGGHTS/Tutorials_public")
+G = 9.81
+
+
+@dataclass
+class Check:
+    name: str
+    value: float
+    reference: float
+    tol: float
+    relative: bool = True
+
+    @property
+    def ok(self) -> bool:
+        scale = abs(self.reference) if self.relative else 1.0
+        return math.isfinite(self.value) and abs(self.value - self.reference) <= self.tol * scale
+
+    def __str__(self) -> str:
+        tol = f"{self.tol:.0%}" if self.relative else f"+-{self.tol:g}"
+        return f"{self.name}: {self.value:.6g} ({self.reference:.6g}, {tol}) {'ok' if self.ok else 'FAILED'}"
+
+
+@dataclass
+class Tutorial:
+    """One public input: where it comes from, where its case.toml goes, what a user must
+    change (each change is a (description, function of the copied folder) pair), what to run
+    natively first (a stage of the tutorial's own workflow that is plain LIGGGHTS), and the
+    physics to check on the host's output."""
+
+    name: str
+    origin: str                       # "cfdem" or "liggghts"
+    source: str                       # path inside the origin
+    case_dir: str                     # where case.toml goes, inside the copy
+    case_toml: str
+    changes: list = field(default_factory=list)
+    native_first: tuple = ()          # (folder inside the copy, script) run with `liggghts -in`
+    checks: Callable | None = None    # (copy, out) -> list[Check]
+
+
+def mkdir(*parts):
+    return (f"create {'/'.join(parts)} (the tutorial's scripts write into it; CFDEM's run "
+            "functions create it)", lambda w: (w.joinpath(*parts)).mkdir(parents=True, exist_ok=True))
+
+
+def drop_line(script: str, pattern: str, why: str):
+    def apply(w: Path):
+        p = w / script
+        text = p.read_text()
+        new = re.sub(rf"^[ \t]*{pattern}.*$", "", text, flags=re.M)
+        if new == text:
+            raise SystemExit(f"corpus: {p}: no line matching {pattern!r}: the tutorial changed")
+        p.write_text(new)
+    return (f"{script}: remove `{pattern}` ({why})", apply)
+
+
+def last_row(path: Path) -> list[float]:
+    rows = [ln.split() for ln in path.read_text().splitlines() if ln.strip() and not ln.startswith("#")]
+    return [float(x) for x in rows[-1]]
+
+
+def settling_checks(w: Path, out: Path) -> list[Check]:
+    """The sphere's last vertical speed (the tutorial's own velocity.txt) against the
+    terminal speed of the Di Felice drag its couplingProperties name, at alpha = 1."""
+    d, rho_p, rho, nu = 1e-4, 3000.0, 10.0, 1e-5
+    law = drag_law("difelice")
+    vol = math.pi * d**3 / 6
+    v_t = brentq(lambda v: float(law(1.0, v, d, rho, nu)) * v - (rho_p - rho) * vol * G, 1e-6, 10.0)
+    row = last_row(w / "DEM" / "post" / "velocity.txt")
+    return [Check("settling speed [m/s]", -row[2], v_t, 0.01)]
+
+
+def history(out: Path) -> list[dict]:
+    return list(csv.DictReader(open(out / "history.csv")))
+
+
+def summary(out: Path) -> dict:
+    return json.loads((out / "summary.json").read_text())
+
+
+def balance_check(out: Path) -> Check:
+    return Check("energy balance error [-]", summary(out).get("energy_balance_error", math.nan), 0.0, 1e-12,
+                 relative=False)
+
+
+def ergun_checks(w: Path, out: Path) -> list[Check]:
+    """The settled bed's pressure drop, averaged over 10 ms of fluid time around 0.05 s (the
+    inlet table ramps 0.002 -> 0.02 m/s over 0.1 s: 0.011 m/s there, below u_mf), against
+    Ergun with the tutorial's own values (its octave script: voidage 0.451, bed 15.6 mm)."""
+    rows = history(out)
+    t = np.array([float(r["time"]) for r in rows])
+    t -= t[0]                                   # the DEM clock starts at the restart's time
+    dp = np.array([float(r["pressure_drop"]) for r in rows])
+    u = 0.002 + 0.018 * 0.05 / 0.1
+    ref = ergun_pressure_drop(u, 0.451335, 1e-3, 0.0156, 10.0, 1.5e-3)
+    return [Check(f"pressure drop at u = {u:.4f} m/s [Pa]", float(dp[abs(t - 0.05) <= 0.005].mean()), ref, 0.10)]
+
+
+def packed_bed_checks(w: Path, out: Path) -> list[Check]:
+    """The last pressure drop against Ergun at the bed's own height and voidage (1005 beads of
+    22 mm in a 0.1 m square column; superficial gas speed 1 m/s from 0/U, rho 1.188 kg/m^3 from
+    0/rho, nu 1.5e-3 m^2/s), and the energy balance with the gas."""
+    last = history(out)[-1]
+    height = float(last["bed_height"])
+    eps = 1.0 - 1005 * math.pi * 0.022**3 / 6 / (0.01 * height)
+    ref = ergun_pressure_drop(1.0, eps, 0.022, height, 1.188, 1.5e-3 * 1.188)
+    return [Check(f"pressure drop, bed {height:.3f} m, voidage {eps:.4f} [Pa]", float(last["pressure_drop"]), ref, 0.10),
+            balance_check(out)]
+
+
+def liggghts_checks(w: Path, out: Path) -> list[Check]:
+    return [balance_check(out)]
+
+
+CFD_MATERIAL = """
+[materials.beads]                   # real values for the contact models (not in the tutorial)
+types = [1]
+temperature = {T}
+density = {density}
+youngs_modulus = 63e9
+poisson_ratio = 0.25
+yield_stress = 500e6
+heat_capacity = {cp}
+conductivity = 1.0
+"""
+
+TUTORIALS = [
+    Tutorial(
+        "settlingTestMPI", "cfdem", "tutorials/cfdemSolverPiso/settlingTestMPI", "CFD",
+        """[dem]
+script = "../DEM/in.liggghts_run"
+
+[effects]
+fluid = true
+
+[fluid]
+case = "."
+drag = "difelice"                   # couplingProperties: forceModels DiFeliceDrag
+void_fraction = "divided"           # couplingProperties: voidFractionModel divided
+
+[time]
+couple_every = 100                  # in.liggghts_run: couple/cfd couple_every 100
+""" + CFD_MATERIAL.format(density=3000.0, cp=840.0, T=300.0),
+        changes=[mkdir("DEM", "post")], checks=settling_checks),
+    Tutorial(
+        "ErgunTestMPI", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI", "CFD",
+        """[dem]
+script = "../DEM/in.liggghts_run"
+
+[effects]
+fluid = true
+
+[fluid]
+case = "."
+drag = "ergun"                      # couplingProperties: KochHillDrag, which plugins.drag lacks
+void_fraction = "divided"
+
+[time]
+couple_every = 100
+""" + CFD_MATERIAL.format(density=2000.0, cp=840.0, T=300.0),
+        changes=[mkdir("DEM", "post", "restart"),
+                 drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1")],
+        native_first=("DEM", "in.liggghts_init"), checks=ergun_checks),
+    Tutorial(
+        "packedBedTemp", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
+        """[dem]
+script = "../DEM/in.liggghts_run"
+
+[effects]
+fluid = true
+contact_heat = "A"
+convection = "gunn"
+
+[fluid]
+case = "."
+drag = "gidaspow"
+void_fraction = "divided"
+
+[time]
+couple_every = 100
+""" + CFD_MATERIAL.format(density=2500.0, cp=0.1, T=0.0),
+        changes=[mkdir("DEM", "post", "restart"),
+                 drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
+                 drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks")],
+        native_first=("DEM", "in.liggghts_init"), checks=packed_bed_checks),
+    Tutorial(
+        "packing", "liggghts", "packing", ".",
+        """[dem]
+script = "in.packing"
+
+[effects]
+contact_heat = "A"
+""" + CFD_MATERIAL.format(density=2500.0, cp=840.0, T=300.0),
+        checks=liggghts_checks),
+    Tutorial(
+        "heatTransfer_1", "liggghts", "heatTransfer_1", ".",
+        """[dem]
+script = "in.heatGran"
+
+[effects]
+contact_heat = "A"
+""" + CFD_MATERIAL.format(density=8000.0, cp=10.0, T=0.0),
+        checks=liggghts_checks),
+    Tutorial(
+        "chute_wear", "liggghts", "chute_wear", ".",
+        """[dem]
+script = "in.chute_wear"
+
+[effects]
+contact_heat = "A"
+""" + CFD_MATERIAL.format(density=2500.0, cp=840.0, T=300.0),
+        checks=liggghts_checks),
+]
+
+
+def prepare(tut: Tutorial, cfdem: Path | None, work: Path) -> Path:
+    base = cfdem if tut.origin == "cfdem" else LIGGGHTS_DOC
+    if base is None:
+        raise FileNotFoundError("no --cfdem checkout given")
+    src = base / tut.source
+    if not src.is_dir():
+        raise FileNotFoundError(f"{src}: no such tutorial folder")
+    dst = work / tut.name
+    shutil.rmtree(dst, ignore_errors=True)
+    shutil.copytree(src, dst)
+    for _, apply in tut.changes:
+        apply(dst)
+    (dst / tut.case_dir / "case.toml").write_text(tut.case_toml)
+    return dst
+
+
+def run_native(copy: Path, folder: str, script: str) -> None:
+    r = subprocess.run(["liggghts", "-in", script, "-screen", "/dev/null"], cwd=copy / folder,
+                       capture_output=True, text=True)
+    if r.returncode:
+        raise RuntimeError(f"native stage {folder}/{script} failed (rc {r.returncode}): {r.stdout[-500:]}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--cfdem", type=Path, help="a CFDEMcoupling-PUBLIC checkout (its tutorials/)")
+    ap.add_argument("--work", type=Path, default=Path("/tmp/collheat-corpus"))
+    ap.add_argument("--only", nargs="+", choices=[t.name for t in TUTORIALS])
+    ap.add_argument("--test", action="store_true", help="the host's smoke run (-test) of each")
+    args = ap.parse_args(argv)
+    args.work.mkdir(parents=True, exist_ok=True)
+    failed = 0
+    print(f"{'tutorial':<16} {'rc':>3} {'wall s':>7}  check: value (reference, tolerance)")
+    for tut in TUTORIALS:
+        if args.only and tut.name not in args.only:
+            continue
+        if tut.origin == "cfdem" and args.cfdem is None:
+            print(f"{tut.name:<16}   -       -  not run: no --cfdem checkout given")
+            continue
+        copy = prepare(tut, args.cfdem, args.work)
+        if tut.native_first:
+            run_native(copy, *tut.native_first)
+        case, out = copy / tut.case_dir, copy / "host-output"
+        cmd = [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(out), "--overwrite"]
+        start = time.perf_counter()
+        r = subprocess.run(cmd + (["--test"] if args.test else []), cwd=ROOT, capture_output=True, text=True)
+        wall = time.perf_counter() - start
+        (copy / "host.log").write_text(r.stdout + r.stderr)
+        checks = tut.checks(copy, out) if r.returncode == 0 and tut.checks else []
+        bad = r.returncode != 0 or not all(c.ok for c in checks)
+        failed += bad
+        first = f"{tut.name:<16} {r.returncode:>3} {wall:7.1f}"
+        if r.returncode:
+            tail = (r.stderr.strip().splitlines() or ["(no message)"])[-1]
+            print(f"{first}  FAILED: {tail} (log: {copy / 'host.log'})")
+        for k, c in enumerate(checks):
+            print(f"{first if k == 0 else '':<28}  {c}")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
