@@ -4,11 +4,12 @@ solver that dies at its first step (exit 3).
 
 ``check_case(folder, file, ranks, energy)`` reads with foamlib: every file it needs parses;
 ``nu`` and, if given there, ``rho`` in constant/transportProperties are numbers (a density
-kept in 0/rho is ``pyhost.engines.fluid_case.case_density``'s); the mesh's patches
-(constant/polyMesh/boundary, else system/blockMeshDict's ``boundary`` or old-style
-``patches``) each with an entry in 0/U and 0/p (0/T with the gas energy) by name, group or
-quoted regular expression; blocks and faces naming existing vertices; with ``ranks`` > 1,
-system/decomposeParDict cutting the mesh into that many subdomains.
+kept in 0/rho is ``pyhost.engines.fluid_case.case_density``'s); a constant/polyMesh is
+whole; the mesh's patches (constant/polyMesh/boundary, else system/blockMeshDict's
+``boundary`` or old-style ``patches``) each have an entry in 0/U and 0/p (0/T with the gas
+energy) by name, group or quoted regular expression; blocks and faces name existing
+vertices; with ``ranks`` > 1, system/decomposeParDict cuts the mesh into that many
+subdomains.
 """
 from __future__ import annotations
 
@@ -43,9 +44,13 @@ def _number(entry) -> float | None:
 def mesh_patches(folder: Path, file: str) -> tuple[str, dict]:
     """The mesh's file and its patches {name: groups (its type, inGroups)}."""
     if (folder / "constant" / "polyMesh" / "owner").is_file():
+        mesh = folder / "constant" / "polyMesh"
+        lacking = [n for n in ("points", "faces", "neighbour", "boundary")
+                   if not ((mesh / n).is_file() or (mesh / f"{n}.gz").is_file())]
+        if lacking:
+            raise SceneError(f"{file}: fluid.case: {mesh}: has owner but lacks {', '.join(lacking)}: give the "
+                             "whole mesh, or remove constant/polyMesh to have it built from system/blockMeshDict")
         rel = "constant/polyMesh/boundary"
-        if not (folder / rel).is_file():
-            raise SceneError(f"{file}: fluid.case: {folder / rel}: missing beside constant/polyMesh/owner")
         entries = _read(folder, rel, file).get(None)
         if not isinstance(entries, list) or not all(isinstance(e, tuple) and len(e) == 2 for e in entries):
             raise SceneError(f"{file}: fluid.case: {folder / rel}: not a list of patches 'name {{ type ...; }}'")

@@ -266,8 +266,11 @@ FLUID_CASES = {   # id: (changes of the valid user case, words the one-line mess
     "0/p regex not matching": ([foam_edit("0/p", ("boundaryField", "xlo")), foam_edit("0/p", ("boundaryField", "xhi")),
                                 foam_edit("0/p", ("boundaryField", '"x(l|h)i"'), {"type": "zeroGradient"})],
                                ["0/p: boundaryField", "patch 'xlo'"]),
-    "polyMesh patch without entry": ([foam_text("constant/polyMesh/owner", ""),
-                                      foam_text("constant/polyMesh/boundary", POLYMESH)],
+    "polyMesh without points": ([foam_text("constant/polyMesh/owner", "")],
+                                ["constant/polyMesh: has owner but lacks points, faces, neighbour, boundary"]),
+    "polyMesh patch without entry": ([foam_text(f"constant/polyMesh/{name}", "")
+                                      for name in ("owner", "points", "faces", "neighbour")]
+                                     + [foam_text("constant/polyMesh/boundary", POLYMESH)],
                                      ["0/U: boundaryField", "patch 'bottom'", "constant/polyMesh/boundary"]),
     "blockMeshDict not OpenFOAM": ([foam_text("system/blockMeshDict", BLOCKS.replace("(0 1 1));", "(0 1 1);"))],
                                    ["system/blockMeshDict: not a valid OpenFOAM file", "line 2, column 10"]),
