@@ -610,6 +610,9 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 dem.command(cmd)
                 continue
             run = parse_run(cmd)
+            if not dem.dt > 0:
+                raise ScriptError(f"{cmd.where()}: the time step is {dem.dt:g} s: give the script a positive "
+                                  "'timestep' before its runs")
             if coupling is None:
                 try:
                     added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
@@ -623,7 +626,10 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             else:
                 coupling.update_walls(walls_of(dem))
                 coupling.check_heat_gran()
-            n = dem.steps(run.steps, run.upto)
+            try:
+                n = dem.steps(run.steps, run.upto)
+            except ScriptError as exc:
+                raise ScriptError(f"{cmd.where()}: {exc}") from None
             if n == 0 and k == last_run and driven is not None:
                 n = round(driven / dem.dt)
                 log(f"{cmd.where()}: the script ends in a run of 0 steps, which the coupling drives: "

@@ -138,12 +138,21 @@ class Dem:
     def steps(self, steps: str, upto: bool) -> int:
         """The number of steps of a ``run`` (a number or a $variable, evaluated by LIGGGHTS)."""
         try:
-            n = int(steps)
+            value = float(int(steps))
         except ValueError:
             self._raw(f"variable collheat_steps equal {steps}")
             self._order("variable", "collheat_steps")
-            n = int(round(self.lmp.variable("collheat_steps")))
-        return n - self.lmp.step if upto else n
+            value = self.lmp.variable("collheat_steps")
+        # LIGGGHTS' own rules for 'run N [upto]' (its run.cpp): a whole N, 0 <= N < 2^31, and an
+        # upto step not before the current one
+        if value != int(value):
+            raise ScriptError(f"run {steps}: {value:g} is not a whole number of steps (LIGGGHTS: 'Expected integer')")
+        n = int(value) - (self.lmp.step if upto else 0)
+        if not 0 <= n <= 2**31 - 1:
+            why = (f"step {int(value)} is before the current step {self.lmp.step}" if upto and n < 0 else
+                   f"{n} steps is outside 0 .. 2^31 - 1")
+            raise ScriptError(f"run {steps}{' upto' if upto else ''}: {why} (LIGGGHTS: 'Invalid run command')")
+        return n
 
     def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False) -> list[str]:
         """What the host adds before the first run: the Temp property (if no fix heat/gran or

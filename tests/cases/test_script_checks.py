@@ -74,10 +74,10 @@ pictures = false
 """
 
 
-def run(tmp_path, script, case_toml):
+def run(tmp_path, script, case_toml, *options):
     (tmp_path / "in.run").write_text(script)
     (tmp_path / "case.toml").write_text(case_toml)
-    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out")],
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out"), *options],
                        capture_output=True, text=True, cwd=ROOT, timeout=600)
     summary = tmp_path / "out" / "summary.json"
     return r, json.loads(summary.read_text()) if summary.exists() else None
@@ -135,3 +135,32 @@ def test_liggghts_warnings_are_shown_once(tmp_path):
     shown = [ln for ln in r.stdout.splitlines() if ln.startswith("LIGGGHTS WARNING") and "insert" in ln.lower()]
     print(shown)
     assert len(shown) == 1 and "each warning is shown once" in shown[0]
+
+
+@pytest.mark.parametrize("runs, message", [
+    ("run 1e11\n", "run 1e11: 100000000000 steps is outside 0 .. 2^31 - 1"),
+    ("run -100\n", "run -100: -100 steps is outside 0 .. 2^31 - 1"),
+    ("variable n equal 300.7\nrun ${n}\n", "run ${n}: 300.7 is not a whole number of steps"),
+    ("run 200\nrun 100 upto\n", "run 100 upto: step 100 is before the current step 200"),
+])
+def test_run_commands_keep_liggghts_rules(tmp_path, runs, message):
+    """'run N' as LIGGGHTS runs it: a whole N from 0 to 2^31 - 1, an 'upto' step not in the
+    past; refused naming the script's line (they were chunked until killed, rounded, or
+    skipped in silence)."""
+    r, _ = run(tmp_path, header() + runs, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert message in r.stderr and "in.run:" in r.stderr
+
+
+def test_a_zero_time_step_is_refused(tmp_path):
+    r, _ = run(tmp_path, header().replace("timestep 1e-5", "timestep 0") + "run 100\n", toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "the time step is 0 s" in r.stderr
+
+
+def test_smoke_run_cuts_the_first_run(tmp_path):
+    """--test with time.test_end = 1 ms stops the script's first (and only) run of 50,000
+    steps after 100 (it used to cut only the runs after the first)."""
+    r, s = run(tmp_path, header() + "run 50000\n", toml() + "[time]\ntest_end = 0.001\n", "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert s["steps"] == 100 and s["time"] == pytest.approx(0.001)
