@@ -1,5 +1,18 @@
+import signal
 import sys
 
-from pyhost.cli import main
+
+def _before_start(signum, frame):
+    """A signal while the command line is still being read (importing every command takes
+    about half a second): a quiet stop, nothing begun, no traceback."""
+    sys.stderr.write(f"interrupted: {signal.Signals(signum).name} received before the command started; "
+                     "nothing was run\n")
+    raise SystemExit(128 + signum)
+
+
+for _signal in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+    signal.signal(_signal, _before_start)
+
+from pyhost.cli import main  # noqa: E402  (after the handlers: the import is the slow part)
 
 sys.exit(main())

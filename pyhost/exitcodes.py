@@ -22,7 +22,8 @@ def classify(exc: BaseException) -> tuple[int, str]:
     from pyhost.engines.openfoam import FluidError
 
     if isinstance(exc, Interrupted):
-        return exc.exit_code, f"interrupted: {exc}; the run stopped cleanly (see its summary.json)"
+        return exc.exit_code, (f"interrupted: {exc}; stopped cleanly (a run that had begun says where in its "
+                               "summary.json)")
     if isinstance(exc, KeyboardInterrupt):
         return 130, "interrupted"
     if isinstance(exc, (SimulationFailed, FluidError)):

@@ -566,6 +566,9 @@ class Coupling:
             self.fluid_frames.write(self.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)
 
     def finish(self, status: str = "completed") -> dict:
+        for series in (self.frames, self.fluid_frames):
+            if series is not None:
+                series.flush()
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
         self.heat_by_model()
         summary = dict(self.totals, status=status, time=self.t, steps=self.steps, groups=self.group_names)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 import sys
 import time
@@ -225,12 +226,18 @@ def collisions_to_csv(out: Path, target: Path | None = None, chunk: int = 1 << 2
 
 class VtkSeries:
     """Points with data, one file per frame, and the .pvd index of the frames so far.
-    ``frames``: those of a checkpoint to continue from; later frame files are removed."""
+    ``frames``: those of a checkpoint to continue from; later frame files are removed.
+    The index is rewritten at most every ``INDEX_EVERY`` seconds of wall time while frames
+    come (rewriting it after each frame made a long series cost quadratic time: 50,000 frames
+    took 900 s), and by :meth:`flush`; a killed process leaves it that much behind."""
+
+    INDEX_EVERY = 2.0       # s of wall time
 
     def __init__(self, folder: Path, name: str, frames: list | None = None):
         self.folder, self.name = Path(folder), name
         self.folder.mkdir(parents=True, exist_ok=True)
         self.frames: list[tuple[float, str]] = [tuple(f) for f in frames or []]
+        self._indexed = -math.inf
         if frames is not None:
             kept = {f for _, f in self.frames}
             for old in self.folder.glob(f"{self.name}_*.vtu"):
@@ -244,10 +251,16 @@ class VtkSeries:
         cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
         meshio.write(self.folder / file, meshio.Mesh(points, cells, point_data=point_data))
         self.frames.append((t, file))
-        self._index()
+        if time.monotonic() - self._indexed >= self.INDEX_EVERY:
+            self._index()
         return self.folder / file
 
+    def flush(self) -> None:
+        """The index of every frame written so far (more frames may follow)."""
+        self._index()
+
     def _index(self) -> None:
+        self._indexed = time.monotonic()
         index = self.folder / f"{self.name}.pvd"
         tmp = index.with_suffix(".pvd.tmp")
         tmp.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n<Collection>\n'

@@ -14,7 +14,8 @@
    series of temperatures and heat received.
 
 Output (``out``): collisions.csv.gz, summary.json, vtk/particles.pvd, post.png. A failure
-keeps what was written before it, and summary.json then says ``"complete": false``.
+keeps what was written before it, and summary.json then says ``"complete": false``, as it
+does when frames were skipped (``skipped``: how many warnings say so).
 """
 from __future__ import annotations
 
@@ -31,6 +32,7 @@ from pyhost.contact_heat import evaluate
 from pyhost.contacts import find_contacts
 from pyhost.dem_input import hertz_collision_time
 from pyhost.dumps import STREAM_ERRORS, DumpError, DumpReader, expand, open_text
+from pyhost.outdir import write_atomic
 from pyhost.output import VtkSeries
 from pyhost.scene import Material, SceneError, Wall, _build, read_toml
 
@@ -148,6 +150,7 @@ class Post:
             raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
         self.warnings = list(script.warnings) if script else []
         self.unplaced = set()            # scene walls whose primitive plane post cannot place (warned)
+        self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()
         self.summary = dict(frames=0, particles=0, collisions=dict(particle_particle=0, particle_wall=0),
                             heat_J={m: 0.0 for m in self.models}, warnings=self.warnings, complete=False)
@@ -406,6 +409,9 @@ class Post:
 
     # -- the job ------------------------------------------------------------------------------------
     def run(self) -> dict:
+        if (self.out / "scene.json").is_file():
+            raise ValueError(f"--out {self.out}: holds the output of a run (scene.json), whose summary.json post "
+                             "would replace: give post a folder of its own")
         self.out.mkdir(parents=True, exist_ok=True)
         try:
             found = self.survey()
@@ -415,17 +421,20 @@ class Post:
             c["v0"] = self.impact_speeds(c)
             self.heat(c)
         finally:
+            if self.series is not None:
+                self.series.flush()
             self.write_summary()
         if self.error is not None:
             raise self.error
         return self.summary
 
     def write_summary(self) -> None:
-        self.summary["complete"] = self.error is None and self.done
         self.summary["warnings"] = list(dict.fromkeys(self.warnings))    # the particle dumps are read twice
+        self.summary["skipped"] = sum(w.startswith("skipped") for w in self.summary["warnings"])
+        self.summary["complete"] = self.error is None and self.done and not self.summary["skipped"]
         if self.error is not None:
             self.summary["error"] = str(self.error)
-        (self.out / "summary.json").write_text(json.dumps(self.summary, indent=1, default=float))
+        write_atomic(self.out / "summary.json", json.dumps(self.summary, indent=1, default=float))
 
     def heat(self, c) -> None:
         """Models over all collisions, heat moved in time order while the particle frames are
@@ -459,7 +468,7 @@ class Post:
         Q = {m: np.zeros(n) for m in self.models}
         columns = (("time", "i", "j", "type_i", "type_j", "wall", "v0")
                    + tuple(f"{k}_{m}" for m in self.models for k in ("Q", "e", "t_coll")))
-        series = VtkSeries(self.out / "vtk", "particles")
+        series = self.series = VtkSeries(self.out / "vtk", "particles")
         type_i = self.particles.type[c["i"]]
         type_j = np.where(wall, 0, self.particles.type[np.where(wall, 0, c["j"])])
         by_pair = np.stack([type_i, type_j], axis=1)

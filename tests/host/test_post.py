@@ -153,7 +153,8 @@ def test_a_failure_keeps_what_came_before_and_says_incomplete(tmp_path):
                 "--skip-bad-frames")
     assert skip.returncode == 0, skip.stderr
     summary = json.loads((tmp_path / "skip" / "summary.json").read_text())
-    assert summary["complete"] is True and summary["frames"] == 2 and len(rows(tmp_path / "skip")) == 1
+    assert summary["complete"] is False and summary["skipped"] == 1     # a frame was skipped: not the whole run
+    assert summary["frames"] == 2 and len(rows(tmp_path / "skip")) == 1
     assert any("skipped" in w and "timestep 20" in w and "line 33" in w for w in summary["warnings"])
 
 
@@ -227,3 +228,17 @@ def test_offline_agrees_with_the_online_run(pour_dumps, tmp_path):
     assert np.allclose(v_off[image], v_on[image], rtol=0.05)
     assert -Q_off[wall].sum() == pytest.approx(run["heat_from_walls"], rel=1e-4)
     assert np.abs(Q_off[~wall]).sum() == pytest.approx(np.abs(Q_on[~wall]).sum(), rel=1e-3)
+
+
+def test_out_holding_a_run_is_refused(tmp_path):
+    """post writes a summary.json of its own: pointed at a run's output folder (scene.json),
+    it refuses instead of replacing the run's summary."""
+    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1, 2]\ntemperature = 300"))
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "scene.json").write_text("{}")
+    (tmp_path / "run" / "summary.json").write_text('{"status": "completed"}')
+    (tmp_path / "d.dump").write_text(HEAD.format(step=0) + "1 1 0.005 0.005 0.005 0 0 0 0.001\n"
+                                     "2 1 0.002 0.002 0.002 0 0 0 0.001\n")
+    r = post(tmp_path / "d.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-5", "--out", tmp_path / "run")
+    assert r.returncode == 2 and "holds the output of a run (scene.json)" in r.stderr
+    assert json.loads((tmp_path / "run" / "summary.json").read_text()) == {"status": "completed"}

@@ -1,5 +1,8 @@
 """``python -m pyhost collide``: JSON keys, lists, models, methods, wall."""
 import json
+import signal
+import time
+from pathlib import Path
 import subprocess
 import sys
 
@@ -41,3 +44,16 @@ def test_help_documents_units():
     r = subprocess.run([sys.executable, "-m", "pyhost", "collide", "--help"], capture_output=True, text=True)
     for text in ("[m/s]", "[Pa]", "[kg/m^3]", "[J/(kg K)]", "[W/(m K)]", "[K]"):
         assert text in r.stdout
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_command_line_is_read_stops_quietly(signum):
+    """Ctrl-C in the first half second (while every command is imported) used to print a
+    KeyboardInterrupt traceback: now one line and 128 + n."""
+    p = subprocess.Popen([sys.executable, "-m", "pyhost", "run", "cases/two-particles", "--out", "/nonexistent/x"],
+                         cwd=Path(__file__).resolve().parents[2], stderr=subprocess.PIPE, text=True)
+    time.sleep(0.15)
+    p.send_signal(signum)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 128 + signum, err
+    assert "Traceback" not in err and "interrupted:" in err

@@ -23,6 +23,7 @@ def test_vtk_series_readable_after_each_frame(tmp_path):
     for k in range(2):
         x = rng.uniform(size=(7, 3))
         series.write(0.1 * k, x, id=np.arange(7), temperature=np.full(7, 300.0 + k))
+        series.flush()
         reader = pyvista.get_reader(str(tmp_path / "particles.pvd"))
         assert reader.time_values == pytest.approx([0.1 * j for j in range(k + 1)])
         reader.set_active_time_value(0.1 * k)
@@ -91,3 +92,18 @@ def test_column_log_resumes_at_a_row_count_and_refuses_ragged_columns(tmp_path):
         f.truncate(16)
     with pytest.raises(ValueError, match="k.i8: 2 rows"):
         read_columns(tmp_path / "c")
+
+
+def test_vtk_index_is_rewritten_on_a_clock_and_whole_at_flush(tmp_path, monkeypatch):
+    """The .pvd index lists every frame once the series is closed; in between it is rewritten
+    at most every INDEX_EVERY seconds (after each frame, 50,000 frames cost quadratic time)."""
+    from pyhost.output import VtkSeries
+
+    monkeypatch.setattr(VtkSeries, "INDEX_EVERY", 1e9)
+    series = VtkSeries(tmp_path, "p")
+    for k in range(3):
+        series.write(0.1 * k, np.zeros((2, 3)), id=np.arange(2))
+    index = tmp_path / "p.pvd"
+    assert index.read_text().count("<DataSet") == 1          # the first frame's, then the clock holds
+    series.flush()
+    assert index.read_text().count("<DataSet") == 3
