@@ -290,6 +290,8 @@ class Coupling:
                 raise ScriptError(f"{self.scene.path}: particle {atoms.id[k]} (type {atoms.type[k]}, materials.{name}) "
                                   f"starts at {atoms.T[k]:g} K: temperatures must be above 0 K; give "
                                   f"materials.{name}.temperature, or the script's fix heat/gran initial_temperature")
+            if self.scene.scripted:
+                self.check_densities(atoms, new, mat)
             self.totals["inserted"] += int(new.sum())
             self.totals["energy_in"] += float(np.sum(C[new] * atoms.T[new]))
         old = ~new & (self.M_by_id[ids] > 0)
@@ -344,6 +346,19 @@ class Coupling:
             e = self.dem.type_pair_value("coefficientRestitution", a, b)
             self.laws[a, b] = DemHertz(1.0 / ((1 - nu[0] ** 2) / E[0] + (1 - nu[1] ** 2) / E[1]), e)
         return self.laws[a, b]
+
+    def check_densities(self, atoms, new, mat) -> None:
+        """A script gives its particles their density (templates, set ... density); the contact
+        models and the heat capacity use the material's: the two must agree (to 1e-6)."""
+        rho = atoms.mass[new] / (4.0 / 3.0 * np.pi * atoms.radius[new] ** 3)
+        want = np.array([m.density for m in self.materials])[mat[new]]
+        bad = np.flatnonzero(np.abs(rho / want - 1.0) > 1e-6)
+        if len(bad):
+            k = np.flatnonzero(new)[bad[0]]
+            name = list(self.scene.materials)[mat[k]]
+            raise ScriptError(f"{self.scene.path}: particle {atoms.id[k]} (type {atoms.type[k]}) has the script's "
+                              f"density {rho[bad[0]]:.6g} kg/m^3, materials.{name}.density is {want[bad[0]]:g}: "
+                              "give both the same value")
 
     def check_heat_gran(self) -> None:
         """At each of a script's runs: a fix heat/gran that appeared has its capacities checked

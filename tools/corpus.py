@@ -38,7 +38,10 @@ from scipy.optimize import brentq
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from foamlib import FoamFile  # noqa: E402
+
 from plugins.drag import get as drag_law  # noqa: E402
+from pyhost.engines.openfoam import run_utility  # noqa: E402
 from pyhost.fluidization import ergun_pressure_drop  # noqa: E402
 
 LIGGGHTS_DOC = Path("/usr/share/doc/liggghts/examples/LIGGGHTS/Tutorials_public")
@@ -125,17 +128,40 @@ def balance_check(out: Path) -> Check:
                  relative=False)
 
 
+def layered_ergun(fluid: Path, time: str, u: float, d: float, rho: float, mu: float) -> tuple[float, float]:
+    """The pressure drop [Pa] a bed's own fluid fraction asks of Ergun at superficial speed u,
+    layer by layer of the fluid mesh (cells binned by height; the fraction a layer's volume
+    mean), from the first layer's centre up, as history.csv measures it; and the pressure
+    drop the solver has there, from its written fields (less the gas's own head)."""
+    for func in ("writeCellCentres", "writeCellVolumes"):
+        run_utility(fluid, "postProcess", "-func", func, "-time", time)
+    read = lambda name: np.asarray(FoamFile(fluid / time / name)["internalField"])
+    alpha, centre, volume, p = read("alpha"), read("C"), read("V"), read("p") * rho
+    z = centre[:, 2]
+    levels = np.sort(z)
+    levels = levels[np.r_[True, np.diff(levels) > 1e-3 * np.ptp(z)]]      # one height per layer (6 digits written)
+    dz = float(np.mean(np.diff(levels)))
+    layer = np.searchsorted(levels, z + 1e-3 * np.ptp(z)) - 1
+    ergun, mean_p = 0.0, []
+    for k in range(len(levels)):
+        s = layer == k
+        a = float(np.average(alpha[s], weights=volume[s]))
+        ergun += (0.5 if k == 0 else 1.0) * (ergun_pressure_drop(u, a, d, dz, rho, mu) if a < 1 else 0.0)
+        mean_p.append(float(np.average(p[s], weights=volume[s])))
+    head = rho * 9.81 * (z.max() - z.min())
+    return ergun, mean_p[0] - mean_p[-1] - head
+
+
 def ergun_checks(w: Path, out: Path) -> list[Check]:
-    """The settled bed's pressure drop, averaged over 10 ms of fluid time around 0.05 s (the
-    inlet table ramps 0.002 -> 0.02 m/s over 0.1 s: 0.011 m/s there, below u_mf), against
-    Ergun with the tutorial's own values (its octave script: voidage 0.451, bed 15.6 mm)."""
-    rows = history(out)
-    t = np.array([float(r["time"]) for r in rows])
-    t -= t[0]                                   # the DEM clock starts at the restart's time
-    dp = np.array([float(r["pressure_drop"]) for r in rows])
+    """The settled bed's pressure drop at fluid time 0.05 s (the inlet table ramps 0.002 ->
+    0.02 m/s over 0.1 s: 0.011 m/s there, below u_mf) against Ergun over the bed's own fluid
+    fraction, layer by layer. The tutorial's own reference (its octave script: voidage 0.451,
+    bed 15.6 mm) is printed beside it: Debian's LIGGGHTS packs this bed denser (about 0.41)."""
     u = 0.002 + 0.018 * 0.05 / 0.1
-    ref = ergun_pressure_drop(u, 0.451335, 1e-3, 0.0156, 10.0, 1.5e-3)
-    return [Check(f"pressure drop at u = {u:.4f} m/s [Pa]", float(dp[abs(t - 0.05) <= 0.005].mean()), ref, 0.10)]
+    ergun, measured = layered_ergun(out / "fluid", "0.05", u, 1e-3, 10.0, 1.5e-3)
+    nominal = ergun_pressure_drop(u, 0.451335, 1e-3, 0.0156, 10.0, 1.5e-3)
+    return [Check(f"pressure drop at u = {u:.4f} m/s (tutorial's nominal Ergun {nominal:.1f} Pa) [Pa]",
+                  measured, ergun, 0.10)]
 
 
 def packed_bed_checks(w: Path, out: Path) -> list[Check]:

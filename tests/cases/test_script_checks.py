@@ -164,3 +164,11 @@ def test_smoke_run_cuts_the_first_run(tmp_path):
     r, s = run(tmp_path, header() + "run 50000\n", toml() + "[time]\ntest_end = 0.001\n", "--test")
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     assert s["steps"] == 100 and s["time"] == pytest.approx(0.001)
+
+
+def test_a_density_other_than_the_materials_is_refused(tmp_path):
+    """The script's particle template says 2500 kg/m^3, case.toml 2700: refused at their
+    insertion, naming both (it was accepted silently; the models would use 2700)."""
+    r, _ = run(tmp_path, header() + "run 100\n", toml().replace("density = 2500.0", "density = 2700.0"))
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "has the script's density 2500 kg/m^3, materials.glass.density is 2700" in r.stderr
