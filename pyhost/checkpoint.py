@@ -39,6 +39,7 @@ import numpy as np
 
 from pyhost.cli import UserError
 from pyhost.outdir import write_atomic
+from pyhost.output import check_logs
 
 FOLDER, RESTART, FORMAT = "checkpoint", "dem.restart", 1
 FILES = (RESTART, "host.npz", "host.json")
@@ -168,6 +169,10 @@ def load(out: Path, scene) -> dict:
             state.update({k: arrays[k] for k in arrays.files})
     except (OSError, ValueError) as exc:
         raise UserError(f"--restart: corrupt checkpoint in {folder}: {exc}") from None
+    try:
+        check_logs(out, state["logs"])
+    except (OSError, ValueError) as exc:
+        raise UserError(f"--restart: {exc}") from None
     state["restart"] = folder / RESTART
     print(f"restart from {folder}: t = {manifest['time']:.6g} s (step {manifest['step']})")
     return state

@@ -231,7 +231,7 @@ class Coupling:
     # -- checkpoint (pyhost.checkpoint writes and reads the files) ---------------------------
     def state(self) -> tuple[dict, dict]:
         """The host's state at the end of a step: (JSON values, arrays)."""
-        logs = dict(collisions=self.collisions.size, history=self.history.size,
+        logs = dict(collisions=self.collisions.mark(), history=self.history.mark(),
                     particles=self.frames.frames if self.frames is not None else None)
         values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, CT0=self.CT0,
                       gas_energy0=getattr(self, "gas_energy0", 0.0), warned=sorted(self.warned), logs=logs)

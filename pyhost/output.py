@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import math
 import os
@@ -22,15 +23,60 @@ import meshio
 import numpy as np
 
 
-class CsvLog:
-    """A CSV file with a fixed header; ``write(rows)`` appends and flushes. ``resume_at``: the
-    size [bytes] of the file at a checkpoint: what came after is cut, and rows follow it."""
+TAIL = 1 << 16          # bytes before a checkpoint's end of a log whose hash the checkpoint keeps
 
-    def __init__(self, path: Path, columns: tuple, resume_at: int | None = None):
+
+def tail_digest(path: Path, size: int) -> str:
+    """sha256 of the last TAIL bytes of ``path`` before byte ``size``."""
+    with open(path, "rb") as f:
+        f.seek(max(0, size - TAIL))
+        return hashlib.sha256(f.read(min(size, TAIL))).hexdigest()
+
+
+def check_resume(path: Path, size: int, digest: str | None) -> None:
+    """A log a restart appends to must hold what it held at the checkpoint: ValueError (exit 2)
+    naming the file if it is missing, shorter (cut after the checkpoint: appending would leave
+    a hole, once padded with zeros) or different before that point (the last TAIL bytes)."""
+    actual = path.stat().st_size if path.is_file() else None
+    if actual is None or actual < size:
+        raise ValueError(f"{path}: {'missing' if actual is None else f'{actual} bytes'}, where the checkpoint "
+                         f"needs its first {size}: it was cut or removed after the checkpoint; restore it, or "
+                         "run anew with --overwrite")
+    if digest is not None and tail_digest(path, size) != digest:
+        raise ValueError(f"{path}: its bytes before the checkpoint's end ({size}) differ from what the run wrote "
+                         "(edited after the checkpoint?); restore it, or run anew with --overwrite")
+
+
+def check_logs(out: Path, logs: dict) -> None:
+    """Every log of a run's output folder against its mark at a checkpoint (``mark()`` of
+    CsvLog or ColumnLog, as the checkpoint's state keeps them), before anything is cut:
+    ValueError naming the first that is missing, shorter or changed. Bare sizes of older
+    checkpoints are checked for length only."""
+    out = Path(out)
+    for name in ("collisions", "history"):
+        mark = logs.get(name)
+        if isinstance(mark, dict) and "tails" in mark:             # binary columns
+            kinds = {c["name"]: c["kind"] for c in json.loads((out / name / SCHEMA).read_text())["columns"]}
+            for c, kind in kinds.items():
+                file = ColumnLog._file_name_of(c, kind)
+                check_resume(out / name / file, int(mark["rows"]) * _DTYPES[kind].itemsize, mark["tails"].get(file))
+        elif mark is not None:
+            size, tail = (mark["size"], mark["tail"]) if isinstance(mark, dict) else (int(mark), None)
+            check_resume(out / f"{name}.csv", size, tail)
+
+
+class CsvLog:
+    """A CSV file with a fixed header; ``write(rows)`` appends and flushes. ``resume_at``: its
+    :meth:`mark` at a checkpoint (or the bare size [bytes] of older checkpoints): the file is
+    checked (``check_resume``), what came after is cut, and rows follow it."""
+
+    def __init__(self, path: Path, columns: tuple, resume_at: int | dict | None = None):
         self.path, self.columns = Path(path), columns
         self.path.parent.mkdir(parents=True, exist_ok=True)
         if resume_at is not None:
-            os.truncate(self.path, resume_at)
+            mark = resume_at if isinstance(resume_at, dict) else dict(size=resume_at, tail=None)
+            check_resume(self.path, mark["size"], mark["tail"])
+            os.truncate(self.path, mark["size"])
             self._file = open(self.path, "a", newline="")
             self._csv = csv.writer(self._file)
             return
@@ -43,6 +89,10 @@ class CsvLog:
     def size(self) -> int:
         """Bytes written so far (all flushed)."""
         return self._file.tell()
+
+    def mark(self) -> dict:
+        """Where a restart resumes this log, and the hash of what precedes it."""
+        return dict(size=self.size, tail=tail_digest(self.path, self.size))
 
     def write(self, rows) -> None:
         self._csv.writerows(rows)
@@ -82,13 +132,16 @@ class ColumnLog:
             old = json.loads((self.folder / SCHEMA).read_text())
             self.categories.update({c["name"]: list(c.get("categories", [])) for c in old["columns"]
                                     if c["name"] in self.categories})
-        self.rows = 0 if resume_at is None else int(resume_at)
+        mark = resume_at if isinstance(resume_at, dict) else dict(rows=resume_at, tails={})
+        self.rows = 0 if resume_at is None else int(mark["rows"])
         self._code = {c: {v: k for k, v in enumerate(cats)} for c, cats in self.categories.items()}
         self._files = {}
         for c in self.columns:
             path = self.folder / self._file_name(c)
             if resume_at is not None:
-                os.truncate(path, self.rows * _DTYPES[self.kinds[c]].itemsize)
+                size = self.rows * _DTYPES[self.kinds[c]].itemsize
+                check_resume(path, size, mark["tails"].get(path.name))
+                os.truncate(path, size)
             self._files[c] = open(path, "ab" if resume_at is not None else "wb")
         self._schema()
 
@@ -108,8 +161,17 @@ class ColumnLog:
 
     @property
     def size(self) -> int:
-        """Rows written so far (all flushed): what ``resume_at`` takes."""
+        """Rows written so far (all flushed)."""
         return self.rows
+
+    def mark(self) -> dict:
+        """Where a restart resumes this log (``resume_at``), with the hash of each column file's
+        bytes before it."""
+        tails = {}
+        for c in self.columns:
+            path = self.folder / self._file_name(c)
+            tails[path.name] = tail_digest(path, self.rows * _DTYPES[self.kinds[c]].itemsize)
+        return dict(rows=self.rows, tails=tails)
 
     def write_columns(self, **arrays) -> None:
         """Rows from equal-length arrays named by the columns."""

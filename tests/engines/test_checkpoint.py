@@ -202,6 +202,12 @@ def test_restart_without_checkpoint_is_refused(two, tmp_path, capsys):
     assert "no checkpoint in" in refused(capsys, "run", folder, "--out", tmp_path / "none", "--restart")
 
 
+def edit_first_byte(path):
+    data = bytearray(path.read_bytes())
+    data[0] = ord("T") if data[0] != ord("T") else ord("t")
+    path.write_bytes(bytes(data))
+
+
 def damage_manifest(ck, key, value):
     m = json.loads((ck / "manifest.json").read_text())
     m[key] = value
@@ -216,6 +222,8 @@ def damage_manifest(ck, key, value):
     (lambda case, ck: (ck / "host.npz").unlink(), "host.npz is missing"),
     (lambda case, ck: os.truncate(ck / "dem.restart", 100), "dem.restart is not the file written"),
     (lambda case, ck: (ck / "host.json").write_text("{"), "host.json is not the file written"),
+    (lambda case, ck: os.truncate(ck.parent / "collisions.csv", 50), "collisions.csv: 50 bytes, where the checkpoint"),
+    (lambda case, ck: edit_first_byte(ck.parent / "history.csv"), "history.csv: its bytes before the checkpoint"),
 ])
 def test_bad_checkpoint_is_refused_and_left_as_it_was(stopped, capsys, damage, message):
     case_dir, out = stopped
