@@ -220,9 +220,16 @@ def read_columns(folder: Path) -> dict:
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise ValueError(f"{folder / SCHEMA}: not a column log schema ({exc})") from None
     out, rows = {}, None
-    for c in cols:
+    for k, c in enumerate(cols):
+        if not isinstance(c, dict) or not {"name", "kind", "file"} <= set(c):
+            raise ValueError(f"{folder / SCHEMA}: columns[{k}]: needs name, kind and file, got {str(c)[:80]}")
+        if c["kind"] not in _DTYPES:
+            raise ValueError(f"{folder / SCHEMA}: columns[{k}] ({c['name']}): unknown kind {c['kind']!r}; "
+                             f"known: {', '.join(_DTYPES)}")
         dtype = _DTYPES[c["kind"]]
         path = folder / c["file"]
+        if not path.is_file():
+            raise ValueError(f"{path}: missing (column {c['name']} of {folder / SCHEMA})")
         size = path.stat().st_size
         if size % dtype.itemsize:
             raise ValueError(f"{path}: {size} bytes, not a whole number of {dtype.itemsize}-byte values")

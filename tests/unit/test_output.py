@@ -1,5 +1,6 @@
 """Output survives as it is written: CSV rows flushed, VTK series readable mid-run."""
 import io
+import json
 
 import numpy as np
 import pytest
@@ -107,3 +108,22 @@ def test_vtk_index_is_rewritten_on_a_clock_and_whole_at_flush(tmp_path, monkeypa
     assert index.read_text().count("<DataSet") == 1          # the first frame's, then the clock holds
     series.flush()
     assert index.read_text().count("<DataSet") == 3
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda cols: cols[0].update(kind="f4"), r"columns\[0\] \(t\): unknown kind 'f4'; known: f8, i8, str"),
+    (lambda cols: cols[1].pop("file"), r"columns\[1\]: needs name, kind and file"),
+    (lambda cols: cols[1].update(file="gone.i8"), r"gone.i8: missing \(column k of"),
+])
+def test_a_damaged_schema_names_the_column(tmp_path, damage, message):
+    """A binary log whose schema lost a key or names an unknown kind or file: ValueError
+    naming the schema and the column (it was a KeyError, exit 1)."""
+    log = ColumnLog(tmp_path / "c", {"t": "f8", "k": "i8"})
+    log.write_columns(t=np.array([0.5]), k=np.array([1]))
+    log.close()
+    path = tmp_path / "c" / "schema.json"
+    schema = json.loads(path.read_text())
+    damage(schema["columns"])
+    path.write_text(json.dumps(schema))
+    with pytest.raises(ValueError, match=message):
+        read_columns(tmp_path / "c")
