@@ -44,10 +44,18 @@ def evaluate(model: str, path: str, materials: list, mat_i, mat_j, R_i, R_j, v0,
     indices mat_i, mat_j (into ``materials``), radii R_i, R_j [m] (inf for walls), normal
     impact speeds v0 [m/s] and temperature differences dT = T_i - T_j [K].
     ``model`` is A, B, C or a comparison model (one path only; e is NaN for those)."""
+    return evaluate_flagged(model, path, materials, mat_i, mat_j, R_i, R_j, v0, dT)[:3]
+
+
+def evaluate_flagged(model: str, path: str, materials: list, mat_i, mat_j, R_i, R_j, v0, dT):
+    """``evaluate`` and, per collision, whether it leaves the models' range as
+    plugins.heat.validity flags it for ``collide``: an output not finite (overflow) or the
+    indentation delta_max beyond the smaller radius (delta_max_exceeds_radius), where the
+    half-space contact theory has no meaning (a 2000 m/s impact)."""
     if model not in MODELS and model not in COMPARISON:
         raise ValueError(f"unknown contact heat model {model!r}; choices: {', '.join(MODEL_NAMES)}")
     n = len(v0)
-    Q, e, t_coll = np.empty(n), np.empty(n), np.empty(n)
+    Q, e, t_coll, delta = np.empty(n), np.empty(n), np.empty(n), np.zeros(n)
     for a, b in set(zip(np.asarray(mat_i).tolist(), np.asarray(mat_j).tolist())):
         sel = np.flatnonzero((mat_i == a) & (mat_j == b))
         props = pair_properties(materials[a], materials[b])
@@ -55,15 +63,19 @@ def evaluate(model: str, path: str, materials: list, mat_i, mat_j, R_i, R_j, v0,
             pair = Pair(R1=R_i[sel], R2=R_j[sel], dT=dT[sel], **props)
             out = COMPARISON[model].heat(v0[sel], pair, dem_pair(materials[a], materials[b]))
             Q[sel], e[sel], t_coll[sel] = out["Q"], out["e"], out["t_coll"]
+            delta[sel] = out.get("delta_max", 0.0)
         elif path == "fast":
             pair = Pair(R1=R_i[sel], R2=R_j[sel], dT=dT[sel], **props)
-            out = collide_fast(v0[sel], pair, model, outputs=("Q", "e", "t_coll"))
-            Q[sel], e[sel], t_coll[sel] = out["Q"], out["e"], out["t_coll"]
+            out = collide_fast(v0[sel], pair, model, outputs=("Q", "e", "t_coll", "delta_max"))
+            Q[sel], e[sel], t_coll[sel], delta[sel] = out["Q"], out["e"], out["t_coll"], out["delta_max"]
         else:
             for k in sel:
                 c = collide(float(v0[k]), Pair(R1=float(R_i[k]), R2=float(R_j[k]), dT=float(dT[k]), **props), model)
-                Q[k], e[k], t_coll[k] = c.Q, c.e, c.t_coll
-    return Q, e, t_coll
+                Q[k], e[k], t_coll[k], delta[k] = c.Q, c.e, c.t_coll, c.delta_max
+    with np.errstate(invalid="ignore"):
+        flagged = ~(np.isfinite(Q) & np.isfinite(t_coll) & (np.isfinite(e) | np.isnan(e))) \
+            | (delta > np.minimum(R_i, R_j))
+    return Q, e, t_coll, flagged
 
 
 def side_heat(models, path: str, materials: list, mat_i, mat_j, R_i, R_j, v0, dT) -> dict:

@@ -32,7 +32,7 @@ import numpy as np
 from plugins import convection
 from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
                                temperature_difference)
-from pyhost.contact_heat import evaluate, restitution_impulse, side_heat
+from pyhost.contact_heat import evaluate_flagged, restitution_impulse, side_heat
 from pyhost.dem_input import script_dem_contacts
 from pyhost import checkpoint, signals
 from pyhost.engines.dem import Dem
@@ -106,7 +106,7 @@ class Coupling:
         self.totals = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0,
                            heat_from_walls=0.0, capped=0, clipped=0, heat_gran_undone=0.0,
                            inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0,
-                           energy_mass_change=0.0,
+                           energy_mass_change=0.0, outside_model_range=0,
                            heat_convected=0.0, heat_convected_gross=0.0)
         self.CT_by_id = np.zeros(0)      # m c T of each id at its last sample [J] (energy balance)
         self.M_by_id = np.zeros(0)       # mass of each id at its last sample [kg] (0: not known)
@@ -249,6 +249,7 @@ class Coupling:
         self.CT_by_id, self.seen = state["CT_by_id"], state["seen"]
         self.M_by_id = state.get("M_by_id", np.zeros(len(self.seen)))
         self.totals.setdefault("energy_mass_change", 0.0)
+        self.totals.setdefault("outside_model_range", 0)
         checkpoint.restore_forces(self.dem, state)
 
     # -- particles ----------------------------------------------------------------------
@@ -347,6 +348,16 @@ class Coupling:
             self.laws[a, b] = DemHertz(1.0 / ((1 - nu[0] ** 2) / E[0] + (1 - nu[1] ** 2) / E[1]), e)
         return self.laws[a, b]
 
+    def flag_outside_range(self, flagged, v0) -> None:
+        """Collisions the contact models do not cover (plugins.heat.validity, as ``collide`` flags
+        them): counted in summary.json (outside_model_range), said once; their heat is moved."""
+        self.totals["outside_model_range"] += int(flagged.sum())
+        if "outside_model_range" not in self.warned:
+            self.warned.add("outside_model_range")
+            print(f"warning: a collision at v0 = {float(np.max(v0[flagged])):.4g} m/s is outside the contact models' "
+                  "range (indentation beyond the smaller radius, or an output overflows): its heat is the models' "
+                  "extrapolation; such collisions are counted in summary.json as outside_model_range")
+
     def check_densities(self, atoms, new, mat) -> None:
         """A script gives its particles their density (templates, set ... density); the contact
         models and the heat capacity use the material's: the two must agree (to 1e-6)."""
@@ -426,7 +437,9 @@ class Coupling:
         side = {}
         if self.heat:
             args = (self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0, np.ones(len(rows)))
-            G, e, t_coll = evaluate(model, *args)                               # Q per kelvin [J/K]
+            G, e, t_coll, flagged = evaluate_flagged(model, *args)              # Q per kelvin [J/K]
+            if flagged.any():
+                self.flag_outside_range(flagged, v0)
             if len(models) > 1:         # side columns: the same collisions at the same dT, nothing moved
                 dT = temperature_difference(atoms.T, i, jl, self.T_wall)
                 side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from pyhost.collisions import WALL_BASE, DemHertz, contact_keys, exchange_heat
-from pyhost.contact_heat import evaluate
+from pyhost.contact_heat import evaluate_flagged
 from pyhost.contacts import find_contacts
 from pyhost.dem_input import hertz_collision_time
 from pyhost.dumps import STREAM_ERRORS, DumpError, DumpReader, expand, open_text
@@ -446,11 +446,20 @@ class Post:
         if (~go).any():
             self.warnings.append(f"{int((~go).sum())} contacts formed with no approach speed: no collision heat")
         G, e, t_coll = {}, {}, {}
+        self.summary["outside_model_range"] = {}
         for model in self.models:
             G[model], e[model], t_coll[model] = np.zeros(n), np.full(n, np.nan), np.full(n, np.nan)
+            flagged = np.zeros(0, bool)
             if go.any():
-                g, ee, tt = evaluate(model, "fast", mats, mi[go], mj[go], R_i[go], R_j[go], c["v0"][go], np.ones(go.sum()))
+                g, ee, tt, flagged = evaluate_flagged(model, "fast", mats, mi[go], mj[go], R_i[go], R_j[go], c["v0"][go],
+                                                      np.ones(go.sum()))
                 G[model][go], e[model][go], t_coll[model][go] = g, ee, tt
+            self.summary["outside_model_range"][model] = int(flagged.sum())
+            if flagged.any():
+                self.warnings.append(f"model {model}: {int(flagged.sum())} collisions outside the contact models' range "
+                                     f"(indentation beyond the smaller radius, or an overflow; fastest "
+                                     f"{float(c['v0'][go][flagged].max()):.4g} m/s): their heat is the models' "
+                                     "extrapolation")
         C = np.full(len(self.particles.type), np.nan)
         known = self.particles.type > 0
         heat_capacity = np.array([m.heat_capacity for m in mats])

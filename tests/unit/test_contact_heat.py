@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from plugins.heat import Pair, collide
-from pyhost.contact_heat import evaluate, pair_properties, restitution_impulse
+from pyhost.contact_heat import evaluate, evaluate_flagged, pair_properties, restitution_impulse
 from pyhost.scene import DemContact, Material
 
 DEM = DemContact(youngs_modulus=1e7, restitution=0.9)
@@ -29,6 +29,23 @@ def test_evaluate_groups_by_material_pair(path):
     for k in range(3):
         ref = collide(v0[k], Pair(R1=R_i[k], R2=R_j[k], dT=dT[k], **pair_properties(mats[mi[k]], mats[mj[k]])), "C")
         assert (Q[k], e[k], t[k]) == pytest.approx((ref.Q, ref.e, ref.t_coll), rel=1e-6)
+
+
+@pytest.mark.parametrize("path", ["exact", "fast"])
+def test_collisions_beyond_the_models_range_are_flagged_as_collide_flags_them(path):
+    """Run and post flag what ``collide`` flags (plugins.heat.validity): at 2000 m/s steel on
+    steel indents deeper than its 1 mm radius; at 1 m/s not. The numbers are those of
+    ``evaluate`` either way."""
+    mats, m0 = [STEEL], np.zeros(3, int)
+    R = np.full(3, 1e-3)
+    v0 = np.array([1.0, 2000.0, 2000.0])
+    R_j = np.array([1e-3, 1e-3, math.inf])                          # the last on a wall
+    Q, e, t, flagged = evaluate_flagged("A", path, mats, m0, m0, R, R_j, v0, np.ones(3))
+    assert flagged.tolist() == [False, True, True]
+    ref = collide(2000.0, Pair(R1=1e-3, R2=1e-3, dT=1.0, **pair_properties(STEEL, STEEL)), "A")
+    assert ref.delta_max > 1e-3
+    assert np.concatenate([Q, e, t]) == pytest.approx(np.concatenate(evaluate("A", path, mats, m0, m0, R, R_j, v0,
+                                                                             np.ones(3))), rel=1e-12)
 
 
 def test_restitution_impulse_conserves_momentum_and_sets_separation():
