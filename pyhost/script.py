@@ -89,6 +89,10 @@ def read_script(path: str | Path, folder: str | Path | None = None, _depth: int 
         if cmd.name in REFUSED:
             raise ScriptError(f"{cmd.where()}: '{cmd.name}': {REFUSED[cmd.name]}; the host runs a script "
                               "command by command (unroll the loop, or give the values as variables)")
+        if cmd.name == "if":
+            _check_if(cmd)
+        if cmd.name == "run":
+            parse_run(cmd)              # 'run ... every' and other forms refused before any engine time
         if cmd.name == "include":
             words = cmd.words
             if len(words) != 2:
@@ -121,6 +125,22 @@ def check_types(commands: list[Command], materials: dict, where: str) -> None:
             if t > n:
                 raise ScriptError(f"{where}: materials.{name}.types: atom type {t} does not exist: "
                                   f"{box.where()} creates {n} atom type{'s' if n > 1 else ''}")
+
+
+def _check_if(cmd: Command) -> None:
+    """The commands inside ``if ... then "..." [elif ... "..."] [else "..."]`` run inside
+    LIGGGHTS, where the host cannot couple them: a ``run`` there would be uncoupled steps
+    whose collisions are never seen, and a refused command would slip through."""
+    try:
+        words = cmd.words
+    except ValueError:
+        return                          # unbalanced quotes: LIGGGHTS says so itself
+    inner = [w.split(None, 1)[0] for w in words[2:] if w not in ("then", "elif", "else") and w.strip()]
+    for name in inner:
+        if name == "run" or name in REFUSED:
+            why = ("the host couples every run itself: write the run outside the if (give its steps as a variable)"
+                   if name == "run" else REFUSED[name])
+            raise ScriptError(f"{cmd.where()}: '{name}' inside 'if': {why}")
 
 
 @dataclass(frozen=True)

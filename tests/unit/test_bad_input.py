@@ -50,3 +50,18 @@ def test_cli_bad_input_one_line_exit_2(args, word):
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and word in lines[0], r.stderr
+
+
+@pytest.mark.parametrize("line, message", [
+    ('if "${a} > 1" then "run 200"', "'run' inside 'if': the host couples every run itself"),
+    ('if "${a} > 1" then "print hi" else "shell rm x"', "'shell' inside 'if': the host does not run shell commands"),
+    ("run 100 every 10 \"print x\"", "'run ... every' is not supported by the host"),
+])
+def test_script_commands_the_host_cannot_couple_are_refused_when_read(tmp_path, line, message):
+    """Found when the script is read, before any engine time, wherever they stand (an 'if'
+    used to run 200 uncoupled steps; 'run ... every' was refused only when reached)."""
+    from pyhost.script import ScriptError, read_script
+
+    (tmp_path / "in.x").write_text(f"variable a equal 2\nrun 10\n{line}\n")
+    with pytest.raises(ScriptError, match=rf"in.x:3: .*{message}"):
+        read_script(tmp_path / "in.x")
