@@ -172,8 +172,13 @@ def packed_bed_checks(w: Path, out: Path) -> list[Check]:
     height = float(last["bed_height"])
     eps = 1.0 - 1005 * math.pi * 0.022**3 / 6 / (0.01 * height)
     ref = ergun_pressure_drop(1.0, eps, 0.022, height, 1.188, 1.5e-3 * 1.188)
+    total = summary(out).get("total_energy_balance_error", math.nan)
     return [Check(f"pressure drop, bed {height:.3f} m, voidage {eps:.4f} [Pa]", float(last["pressure_drop"]), ref, 0.10),
-            balance_check(out)]
+            balance_check(out),
+            # particles and gas: what the gas carried out through the outlet (its outlet
+            # temperature) against what the particles gave it; the gas energy equation is solved to
+            # its solver's tolerance, not to round-off
+            Check("energy balance of particles and gas [-]", total, 0.0, 1e-6, relative=False)]
 
 
 def liggghts_checks(w: Path, out: Path) -> list[Check]:
