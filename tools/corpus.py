@@ -185,104 +185,62 @@ def liggghts_checks(w: Path, out: Path) -> list[Check]:
     return [balance_check(out)]
 
 
-CFD_MATERIAL = """
+MATERIAL = """
 [materials.beads]                   # real values for the contact models (not in the tutorial)
 types = [1]
-temperature = {T}
-density = {density}
+temperature = {T}                   # 0: the script's own (its fix heat/gran)
+density = {density}                 # = the script's particle density (checked)
 youngs_modulus = 63e9
 poisson_ratio = 0.25
 yield_stress = 500e6
-heat_capacity = {cp}
+heat_capacity = {cp}                # = the script's thermalCapacity where it has one (checked)
 conductivity = 1.0
 """
 
-TUTORIALS = [
-    Tutorial(
-        "settlingTestMPI", "cfdem", "tutorials/cfdemSolverPiso/settlingTestMPI", "CFD",
-        """[dem]
-script = "../DEM/in.liggghts_run"
+
+def cfdem_scene(drag: str, density: float, *, cp: float = 840.0, T: float = 300.0, effects: str = "") -> str:
+    """The case.toml a user writes into a CFDEM tutorial's CFD/ folder (docs/tutorials.md)."""
+    return f"""[dem]
+script = "../DEM/in.liggghts_run"   # run from CFD/, as CFDEM runs LIGGGHTS
 
 [effects]
 fluid = true
-
+{effects}
 [fluid]
 case = "."
-drag = "difelice"                   # couplingProperties: forceModels DiFeliceDrag
+drag = "{drag}"
 void_fraction = "divided"           # couplingProperties: voidFractionModel divided
 
 [time]
-couple_every = 100                  # in.liggghts_run: couple/cfd couple_every 100
-""" + CFD_MATERIAL.format(density=3000.0, cp=840.0, T=300.0),
-        changes=[mkdir("DEM", "post")], checks=settling_checks),
-    Tutorial(
-        "ErgunTestMPI", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI", "CFD",
-        """[dem]
-script = "../DEM/in.liggghts_run"
+couple_every = 100                  # the script's couple/cfd couple_every
+""" + MATERIAL.format(density=density, cp=cp, T=T)
 
-[effects]
-fluid = true
 
-[fluid]
-case = "."
-drag = "ergun"                      # couplingProperties: KochHillDrag, which plugins.drag lacks
-void_fraction = "divided"
+def liggghts_scene(script: str, density: float, *, cp: float = 840.0, T: float = 300.0) -> str:
+    """The case.toml beside a Debian LIGGGHTS tutorial's script."""
+    return f'[dem]\nscript = "{script}"\n\n[effects]\ncontact_heat = "A"\n' + MATERIAL.format(density=density, cp=cp, T=T)
 
-[time]
-couple_every = 100
-""" + CFD_MATERIAL.format(density=2000.0, cp=840.0, T=300.0),
-        changes=[mkdir("DEM", "post", "restart"),
-                 drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1")],
-        native_first=("DEM", "in.liggghts_init"), checks=ergun_checks),
-    Tutorial(
-        "packedBedTemp", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
-        """[dem]
-script = "../DEM/in.liggghts_run"
 
-[effects]
-fluid = true
-contact_heat = "A"
-convection = "gunn"
-
-[fluid]
-case = "."
-drag = "gidaspow"
-void_fraction = "divided"
-
-[time]
-couple_every = 100
-""" + CFD_MATERIAL.format(density=2500.0, cp=0.1, T=0.0),
-        changes=[mkdir("DEM", "post", "restart"),
-                 drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
-                 drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks")],
-        native_first=("DEM", "in.liggghts_init"), checks=packed_bed_checks),
-    Tutorial(
-        "packing", "liggghts", "packing", ".",
-        """[dem]
-script = "in.packing"
-
-[effects]
-contact_heat = "A"
-""" + CFD_MATERIAL.format(density=2500.0, cp=840.0, T=300.0),
-        checks=liggghts_checks),
-    Tutorial(
-        "heatTransfer_1", "liggghts", "heatTransfer_1", ".",
-        """[dem]
-script = "in.heatGran"
-
-[effects]
-contact_heat = "A"
-""" + CFD_MATERIAL.format(density=8000.0, cp=10.0, T=0.0),
-        checks=liggghts_checks),
-    Tutorial(
-        "chute_wear", "liggghts", "chute_wear", ".",
-        """[dem]
-script = "in.chute_wear"
-
-[effects]
-contact_heat = "A"
-""" + CFD_MATERIAL.format(density=2500.0, cp=840.0, T=300.0),
-        checks=liggghts_checks),
+TUTORIALS = [
+    Tutorial("settlingTestMPI", "cfdem", "tutorials/cfdemSolverPiso/settlingTestMPI", "CFD",
+             cfdem_scene("difelice", 3000.0),                   # couplingProperties: DiFeliceDrag
+             changes=[mkdir("DEM", "post")], checks=settling_checks),
+    Tutorial("ErgunTestMPI", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI", "CFD",
+             cfdem_scene("ergun", 2000.0),                      # its KochHillDrag is not in plugins.drag
+             changes=[mkdir("DEM", "post", "restart"),
+                      drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1")],
+             native_first=("DEM", "in.liggghts_init"), checks=ergun_checks),
+    Tutorial("packedBedTemp", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
+             cfdem_scene("gidaspow", 2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\nconvection = "gunn"\n'),
+             changes=[mkdir("DEM", "post", "restart"),
+                      drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
+                      drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks")],
+             native_first=("DEM", "in.liggghts_init"), checks=packed_bed_checks),
+    Tutorial("packing", "liggghts", "packing", ".", liggghts_scene("in.packing", 2500.0), checks=liggghts_checks),
+    Tutorial("heatTransfer_1", "liggghts", "heatTransfer_1", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),
+             checks=liggghts_checks),
+    Tutorial("chute_wear", "liggghts", "chute_wear", ".", liggghts_scene("in.chute_wear", 2500.0),
+             checks=liggghts_checks),
 ]
 
 
