@@ -272,7 +272,8 @@ def main(argv=None) -> int:
     ap.add_argument("--cfdem", type=Path, help="a CFDEMcoupling-PUBLIC checkout (its tutorials/)")
     ap.add_argument("--work", type=Path, default=Path("/tmp/collheat-corpus"))
     ap.add_argument("--only", nargs="+", choices=[t.name for t in TUTORIALS])
-    ap.add_argument("--test", action="store_true", help="the host's smoke run (-test) of each")
+    ap.add_argument("--test", action="store_true", help="the host's smoke run (-test) of each: exit codes and wall "
+                                                        "times only, no physics checks")
     args = ap.parse_args(argv)
     args.work.mkdir(parents=True, exist_ok=True)
     failed = 0
@@ -292,7 +293,8 @@ def main(argv=None) -> int:
         r = subprocess.run(cmd + (["--test"] if args.test else []), cwd=ROOT, capture_output=True, text=True)
         wall = time.perf_counter() - start
         (copy / "host.log").write_text(r.stdout + r.stderr)
-        checks = tut.checks(copy, out) if r.returncode == 0 and tut.checks else []
+        # a smoke run ends before the states the checks are about (a settled speed, a time)
+        checks = tut.checks(copy, out) if r.returncode == 0 and tut.checks and not args.test else []
         bad = r.returncode != 0 or not all(c.ok for c in checks)
         failed += bad
         first = f"{tut.name:<16} {r.returncode:>3} {wall:7.1f}"
