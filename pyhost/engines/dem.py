@@ -140,7 +140,13 @@ class Dem:
         try:
             value = float(int(steps))
         except ValueError:
-            self._raw(f"variable collheat_steps equal {steps}")
+            try:
+                self._raw(f"variable collheat_steps equal {steps}")
+                # evaluated inside a tried command, so that a bad expression (run ${word}) is an
+                # error naming the script's line, not the end of the process
+                self._raw("variable collheat_checked equal ${collheat_steps}")
+            except LiggghtsError as exc:
+                raise ScriptError(f"run {steps}: {exc}") from None
             self._order("variable", "collheat_steps")
             value = self.lmp.variable("collheat_steps")
         # LIGGGHTS' own rules for 'run N [upto]' (its run.cpp): a whole N, 0 <= N < 2^31, and an

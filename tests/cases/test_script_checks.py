@@ -142,6 +142,8 @@ def test_liggghts_warnings_are_shown_once(tmp_path):
     ("run -100\n", "run -100: -100 steps is outside 0 .. 2^31 - 1"),
     ("variable n equal 300.7\nrun ${n}\n", "run ${n}: 300.7 is not a whole number of steps"),
     ("run 200\nrun 100 upto\n", "run 100 upto: step 100 is before the current step 200"),
+    ("variable w string hello\nrun ${w}\n", "run ${w}: "),
+    ("run ${undefined}\n", "run ${undefined}: "),
 ])
 def test_run_commands_keep_liggghts_rules(tmp_path, runs, message):
     """'run N' as LIGGGHTS runs it: a whole N from 0 to 2^31 - 1, an 'upto' step not in the
