@@ -602,7 +602,13 @@ class Coupling:
         summary = dict(self.totals, status=status, time=self.t, steps=self.steps, groups=self.group_names)
         if self.heat:
             atoms = self.dem.atoms(True)
-            self.track_particles(atoms)
+            try:
+                self.track_particles(atoms)
+            except ScriptError as exc:    # what stopped the run (a type without material): still a summary
+                if status == "completed":
+                    raise
+                summary["energy_balance"] = f"not computed: {exc}"
+                return self.write_summary(summary)
             CT = float(np.sum(self.C * atoms.T))
             t = self.totals
             came_in = self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"]) + abs(t["energy_mass_change"])
@@ -616,6 +622,9 @@ class Coupling:
                 summary.update(gas_energy_start=self.gas_energy0, gas_energy_end=gas,
                                heat_through_fluid_boundaries=through,
                                total_energy_balance_error=residual / max(came_in + self.gas_energy0 + abs(through), 1e-300))
+        return self.write_summary(summary)
+
+    def write_summary(self, summary: dict) -> dict:
         write_atomic(self.out / "summary.json", json.dumps(summary, indent=1))
         self.collisions.close()
         self.history.close()

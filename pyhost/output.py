@@ -271,10 +271,27 @@ def read_collisions(out: Path) -> dict:
         if header is None:
             raise ValueError(f"{path}: empty (no header)")
         rows = list(reader)
+    short = next((k for k, row in enumerate(rows) if len(row) != len(header)), None)
+    if short is not None:
+        raise ValueError(f"{path}: line {short + 2}: {len(rows[short])} fields, the header has {len(header)}")
     text = np.array(rows, str).reshape(-1, len(header))
     kinds = collision_kinds(header)
-    return {c: text[:, k] if kinds[c] == "str" else text[:, k].astype(_DTYPES[kinds[c]].newbyteorder("="))
-            for k, c in enumerate(header)}
+    out = {}
+    for k, c in enumerate(header):
+        try:
+            out[c] = text[:, k] if kinds[c] == "str" else text[:, k].astype(_DTYPES[kinds[c]].newbyteorder("="))
+        except ValueError:
+            bad = next(r for r, v in enumerate(text[:, k]) if not _parses(v, kinds[c]))
+            raise ValueError(f"{path}: line {bad + 2}, column {c}: {str(text[bad, k])!r} is not a number") from None
+    return out
+
+
+def _parses(value: str, kind: str) -> bool:
+    try:
+        (int if kind == "i8" else float)(value)
+        return True
+    except ValueError:
+        return False
 
 
 def collisions_to_csv(out: Path, target: Path | None = None, chunk: int = 1 << 20) -> Path:
@@ -286,10 +303,15 @@ def collisions_to_csv(out: Path, target: Path | None = None, chunk: int = 1 << 2
     tmp = target.with_name(target.name + ".tmp")
     log = CsvLog(tmp, tuple(cols))
     n = len(next(iter(cols.values()))) if cols else 0
-    for a in range(0, n, chunk):
-        log.write_columns(**{c: v[a:a + chunk] for c, v in cols.items()})
-    log.close()
-    tmp.replace(target)
+    try:
+        for a in range(0, n, chunk):
+            log.write_columns(**{c: v[a:a + chunk] for c, v in cols.items()})
+        log.close()
+        tmp.replace(target)
+    except BaseException:               # a full disk or a stop: no half-written file stays behind
+        log.close()
+        tmp.unlink(missing_ok=True)
+        raise
     return target
 
 

@@ -174,3 +174,14 @@ def test_a_density_other_than_the_materials_is_refused(tmp_path):
     r, _ = run(tmp_path, header() + "run 100\n", toml().replace("density = 2500.0", "density = 2700.0"))
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
     assert "has the script's density 2500 kg/m^3, materials.glass.density is 2700" in r.stderr
+
+
+def test_a_type_without_material_mid_run_still_leaves_a_summary(tmp_path):
+    """Particles of a type no material names, inserted by a later part of the script: exit 2
+    naming the type, and summary.json of what was done before (there was none)."""
+    script = header(types=2) + "run 200\n" + \
+        "create_atoms 2 single 0.01 0.01 0.019 units box\nset type 2 diameter 0.002 density 2500\nrun 200\n"
+    r, s = run(tmp_path, script, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "atom type(s) [2] have no material" in r.stderr
+    assert s is not None and s["status"].startswith("stopped at t = ") and s["steps"] == 200

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import pyvista
 
+from pyhost.loop import COLLISION_COLUMNS
 from pyhost.output import (ColumnLog, CsvLog, Progress, VtkSeries, collision_kinds, collisions_to_csv,
                            read_collisions, read_columns)
 
@@ -127,3 +128,20 @@ def test_a_damaged_schema_names_the_column(tmp_path, damage, message):
     path.write_text(json.dumps(schema))
     with pytest.raises(ValueError, match=message):
         read_columns(tmp_path / "c")
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda lines: lines.insert(2, "0.5,1,2"), r"collisions.csv: line 3: 3 fields, the header has 9"),
+    (lambda lines: lines.__setitem__(1, lines[1].replace("0.25", "x.25", 1)), r"line 2, column time: 'x.25' is not"),
+])
+def test_a_damaged_collision_log_names_file_and_line(tmp_path, damage, message):
+    """A collisions.csv cut or edited by hand: ValueError naming the file, the line and the
+    column (it was numpy's message, with neither)."""
+    log = CsvLog(tmp_path / "collisions.csv", COLLISION_COLUMNS)
+    log.write([(0.25, 1, 2, 0, 0.1, 1e-6, 0.8, 1e-5, "A"), (0.5, 2, 3, 0, 0.2, 2e-6, 0.7, 1e-5, "A")])
+    log.close()
+    lines = (tmp_path / "collisions.csv").read_text().splitlines()
+    damage(lines)
+    (tmp_path / "collisions.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=message):
+        read_collisions(tmp_path)
