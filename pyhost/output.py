@@ -10,6 +10,7 @@
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import json
@@ -21,6 +22,17 @@ from pathlib import Path
 
 import meshio
 import numpy as np
+
+
+@contextlib.contextmanager
+def _naming(path: Path):
+    """An OSError of a write (a full disk) names the file it was writing."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None:
+            exc.filename = str(path)
+        raise
 
 
 TAIL = 1 << 16          # bytes before a checkpoint's end of a log whose hash the checkpoint keeps
@@ -95,8 +107,9 @@ class CsvLog:
         return dict(size=self.size, tail=tail_digest(self.path, self.size))
 
     def write(self, rows) -> None:
-        self._csv.writerows(rows)
-        self._file.flush()
+        with _naming(self.path):
+            self._csv.writerows(rows)
+            self._file.flush()
 
     def write_columns(self, **arrays) -> None:
         """Rows from equal-length arrays named by the columns."""
@@ -194,7 +207,8 @@ class ColumnLog:
                 a = np.array([codes[v] for v in values.tolist()], "<u2")[inverse.ravel()]
             else:
                 a = a.astype(_DTYPES[self.kinds[c]], copy=False)
-            self._files[c].write(a.tobytes())
+            with _naming(self._files[c].name):
+                self._files[c].write(a.tobytes())
         if new:
             self._schema()
         for f in self._files.values():

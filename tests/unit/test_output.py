@@ -1,5 +1,7 @@
 """Output survives as it is written: CSV rows flushed, VTK series readable mid-run."""
+import csv
 import io
+import os
 import json
 
 import numpy as np
@@ -145,3 +147,27 @@ def test_a_damaged_collision_log_names_file_and_line(tmp_path, damage, message):
     (tmp_path / "collisions.csv").write_text("\n".join(lines) + "\n")
     with pytest.raises(ValueError, match=message):
         read_collisions(tmp_path)
+
+
+def test_a_full_disk_names_the_log_it_was_writing(tmp_path):
+    """A write that fails (ENOSPC, as from a full disk) names the file: the command line then
+    says 'collisions.csv: No space left on device', not 'a file: ...'."""
+    import errno
+
+    from pyhost.exitcodes import classify
+
+    class Full:
+        def write(self, data):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+        def flush(self):
+            pass
+
+    log = CsvLog(tmp_path / "collisions.csv", ("time", "i"))
+    log._file.close()
+    log._file = Full()
+    log._csv = csv.writer(log._file)
+    with pytest.raises(OSError) as err:
+        log.write([(0.5, 1)])
+    code, message = classify(err.value)
+    assert code == 2 and message == f"{tmp_path / 'collisions.csv'}: No space left on device"
