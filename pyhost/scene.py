@@ -51,6 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from plugins.convection import CORRELATIONS
+from plugins.drag import LAWS as DRAG_LAWS
 from plugins.heat import MODEL_NAMES, MODELS
 
 
@@ -182,7 +183,7 @@ class Fluid:
                                              "inlet_velocity: piecewise linear, held after the last")
     plenum: float = spec(">=0", 0.0, "particle-free fluid layer below the box [m]: the box's z lo "
                                       "wall is then a distributor, and the inlet sees no particles")
-    drag: str = spec("in:difelice,gidaspow,ergun,wenyu", "gidaspow", "drag law (plugins.drag)")
+    drag: str = spec("in:" + ",".join(sorted(DRAG_LAWS)), "gidaspow", "drag law (plugins.drag)")
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
     sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")
     alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]")

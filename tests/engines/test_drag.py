@@ -47,3 +47,16 @@ def test_gidaspow_dense_branch_is_ergun_per_unit_bed_volume():
     expected = (150 * (1 - alpha)**2 * RHO * NU / (alpha * D**2)
                 + 1.75 * (1 - alpha) * RHO * slip / D)
     assert beta == pytest.approx(expected, rel=1e-12)
+
+
+def test_koch_hill_limits():
+    """Koch-Hill: Stokes' drag 3 pi mu d at alpha = 1 and creeping flow; in a dense bed at low
+    Re, Carman-Kozeny's pressure gradient 180 phi^2 mu u_s / (alpha^3 d^2) through model A's
+    alpha grad p = n K (u - v)."""
+    k = drag.get("koch_hill")(1.0, 1e-9, D, RHO, NU)
+    assert k == pytest.approx(3 * np.pi * RHO * NU * D, rel=1e-5)       # phi floored at 1e-12: 3 sqrt(phi/2)
+    alpha, u_s = 0.45, 1e-6                                     # m/s superficial: Re ~ 1e-3
+    k = drag.get("koch_hill")(alpha, u_s / alpha, D, RHO, NU)
+    n = (1 - alpha) / (np.pi * D**3 / 6)
+    gradient = n * k * (u_s / alpha) / alpha
+    assert gradient == pytest.approx(180 * (1 - alpha)**2 * RHO * NU * u_s / (alpha**3 * D**2), rel=1e-3)
