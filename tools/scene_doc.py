@@ -51,7 +51,9 @@ def page() -> str:
         lines += [f"## {title}", "", text, "", "| key | type | default | meaning |", "|---|---|---|---|"]
         for f in dataclasses.fields(cls):
             kind = hints[f.name]
-            name = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in typing.get_args(kind))
+            parts = [kind] if isinstance(kind, type) else [k for k in typing.get_args(kind) if k is not type(None)]
+            name = " or ".join(k.__name__ for k in parts) + ("" if isinstance(kind, type) or len(parts) == len(
+                typing.get_args(kind)) else " (optional)")
             rule = f.metadata.get("rule", "")
             if rule == "models":
                 rule = "in:none," + ",".join(MODEL_NAMES)
