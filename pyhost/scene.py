@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import tomllib
 import typing
 from dataclasses import dataclass, field
@@ -436,6 +437,9 @@ def _script_keys(dem, path, file):
         raise SceneError(f"{file}: dem.script: no such file {str(script)!r}")
     for where in ("variables", "test_variables"):
         for name, value in getattr(dem, where).items():
+            if not re.fullmatch(r"[A-Za-z0-9_]+", name):       # LIGGGHTS' own rule (variable.cpp)
+                raise SceneError(f"{file}: dem.{where}: {name!r} is not a LIGGGHTS variable name (letters, digits "
+                                 "and underscores only)")
             if isinstance(value, bool) or not isinstance(value, (str, int, float)) or not str(value).strip():
                 raise SceneError(f"{file}: dem.{where}.{name}: must be a number or a word, got {value!r}")
 

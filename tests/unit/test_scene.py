@@ -128,3 +128,15 @@ def test_bad_inlet_table_names_the_key(tmp_path, table, message):
 def test_inlet_table_and_velocity_exclude_each_other(tmp_path):
     with pytest.raises(SceneError, match="either inlet_table or inlet_velocity"):
         load_scene(write(tmp_path, VALID + FLUID.replace("[fluid]", "[fluid]\ninlet_velocity = 1.0")))
+
+
+def test_a_variable_name_liggghts_cannot_take_is_refused(tmp_path):
+    """dem.test_variables = { "n fill" = 5 }: LIGGGHTS' -var would end the process with an empty
+    message; refused when the scene is read, naming the key."""
+    (tmp_path / "in.x").write_text("run 10\n")
+    (tmp_path / "case.toml").write_text('[dem]\nscript = "in.x"\ntest_variables = { "n fill" = 5 }\n'
+                                        '[materials.m]\ntypes = [1]\ndensity = 1.0\nyoungs_modulus = 1.0\n'
+                                        'poisson_ratio = 0.3\nyield_stress = 1.0\nheat_capacity = 1.0\n'
+                                        'conductivity = 1.0\n')
+    with pytest.raises(SceneError, match=r"dem.test_variables: 'n fill' is not a LIGGGHTS variable name"):
+        load_scene(tmp_path / "case.toml")
