@@ -677,7 +677,10 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             if max_time is not None:
                 n = min(n, round(max_time / dem.dt) - coupling.steps)
             if n > 0:
-                coupling.advance(n)
+                try:
+                    coupling.advance(n)
+                except LiggghtsError as exc:      # e.g. "Lost atoms" in a chunk not tried first
+                    raise type(exc)(f"{cmd.where()}: {exc}") from None
             dem.report_warnings(cmd)
         if coupling is not None and coupling.steps == 0:
             raise ScriptError(f"{scene.path}: the script's runs simulate no step (its last is "

@@ -1,14 +1,20 @@
 // What LIGGGHTS 3.8's C library interface lacks, for pyhost/liggghts.py:
 // the size of a local compute (its row count is not in the C API), the force array of a
-// `fix external pf/array`, and a report of LIGGGHTS' last error when it ends the process
-// (through exit or MPI_Abort).
+// `fix external pf/array`, commands and runs that return LIGGGHTS' error instead of ending
+// the process, and a report of LIGGGHTS' last error when it does end the process (through
+// exit or MPI_Abort).
+#include <csetjmp>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <dlfcn.h>
 #include <mpi.h>
 #include "lammps.h"
+#include "library.h"
+#include "error.h"
 #include "modify.h"
 #include "compute.h"
+#include "fix.h"
 #include "fix_external.h"
 #include "update.h"
 
@@ -33,7 +39,113 @@ static void report_exit()
         std::fprintf(stderr, "LIGGGHTS ended the process: %s(log: %s)\n", last, exit_log);
 }
 
+// ---- errors that return --------------------------------------------------------------
+// LIGGGHTS 3.8 ends the process on any error: Error::all and its kin call exit(1) (every
+// rank together), Error::one calls MPI_Abort (one rank). This library is loaded before
+// libliggghts with RTLD_GLOBAL, and libliggghts calls them through its PLT, so the
+// definitions below take their place. Inside collheat_command / collheat_file (``armed``)
+// they write LIGGGHTS' own ERROR line and jump back there, which returns 1 with the message
+// (collheat_failure). Outside, they do what LIGGGHTS does (the original, found by dlsym).
+// After such a return the LIGGGHTS instance is left mid-command: read its atoms if need be,
+// but run nothing more (pyhost/engines/liggghts.py refuses to).
+static std::jmp_buf *armed = nullptr;
+static char failure[4096] = "";
+
+template <typename Fn>
+static Fn original(const char *symbol) { return reinterpret_cast<Fn>(dlsym(RTLD_NEXT, symbol)); }
+
+// Every rank of the world calls this together (as Error::all): rank 0 writes the line.
+static void fail_all(MPI_Comm world, FILE *screen, FILE *logfile, const char *text)
+{
+    MPI_Barrier(world);
+    int me;
+    MPI_Comm_rank(world, &me);
+    std::snprintf(failure, sizeof failure, "ERROR: %s", text);
+    if (me == 0) {
+        if (screen) { std::fprintf(screen, "%s\n", failure); std::fflush(screen); }
+        if (logfile) { std::fprintf(logfile, "%s\n", failure); std::fflush(logfile); }
+    }
+    std::jmp_buf *back = armed;
+    armed = nullptr;
+    std::longjmp(*back, 1);
+}
+
+namespace LAMMPS_NS {
+
+void Error::all(const char *file, int line, const char *str)
+{
+    if (armed) {
+        char text[3900];
+        std::snprintf(text, sizeof text, "%s (%s:%d)", str, file, line);
+        fail_all(world, screen, logfile, text);
+    }
+    original<void (*)(Error *, const char *, int, const char *)>(
+        "_ZN9LAMMPS_NS5Error3allEPKciS2_")(this, file, line, str);
+    std::abort();
+}
+
+void Error::fix_error(const char *file, int line, Fix *fix, const char *str, const char *str2)
+{
+    if (armed) {
+        char text[3900];
+        // (the four-argument fix_error of libliggghts comes here through its PLT)
+        if (std::strlen(str2) > 2)
+            std::snprintf(text, sizeof text, "Fix %s (id %s): %s (%s:%d)", fix->style, fix->id, str2, file, line);
+        else
+            std::snprintf(text, sizeof text, "Illegal fix %s (id %s) command (%s:%d)", fix->style, fix->id, file, line);
+        fail_all(world, screen, logfile, text);
+    }
+    original<void (*)(Error *, const char *, int, Fix *, const char *, const char *)>(
+        "_ZN9LAMMPS_NS5Error9fix_errorEPKciPNS_3FixES2_S2_")(this, file, line, fix, str, str2);
+    std::abort();
+}
+
+void Error::compute_error(const char *file, int line, Compute *compute, const char *str)
+{
+    if (armed) {
+        char text[3900];
+        std::snprintf(text, sizeof text, "Compute %s (id %s): %s (%s:%d)", compute->style, compute->id, str, file, line);
+        fail_all(world, screen, logfile, text);
+    }
+    original<void (*)(Error *, const char *, int, Compute *, const char *)>(
+        "_ZN9LAMMPS_NS5Error13compute_errorEPKciPNS_7ComputeES2_")(this, file, line, compute, str);
+    std::abort();
+}
+
+// One rank alone: returns only when it is the only rank (the others would wait forever).
+void Error::one(const char *file, int line, const char *str)
+{
+    int n;
+    MPI_Comm_size(world, &n);
+    if (armed && n == 1) {
+        char text[3900];
+        std::snprintf(text, sizeof text, "%s (%s:%d)", str, file, line);
+        fail_all(world, screen, logfile, text);
+    }
+    original<void (*)(Error *, const char *, int, const char *)>(
+        "_ZN9LAMMPS_NS5Error3oneEPKciS2_")(this, file, line, str);
+    std::abort();
+}
+
+}  // namespace LAMMPS_NS
+
 extern "C" {
+
+// One LIGGGHTS command (is_file != 0: an input file, as lammps_file): 0 when done, 1 when
+// LIGGGHTS reported an error (its ERROR line from collheat_failure).
+int collheat_command(void *ptr, const char *line, int is_file)
+{
+    std::jmp_buf back;
+    if (setjmp(back)) return 1;
+    armed = &back;
+    failure[0] = 0;
+    if (is_file) lammps_file(ptr, const_cast<char *>(line));
+    else lammps_command(ptr, const_cast<char *>(line));
+    armed = nullptr;
+    return 0;
+}
+
+const char *collheat_failure() { return failure; }
 
 // Error::one ends with MPI_Abort, which skips atexit: this definition, found before
 // OpenMPI's because pyhost.liggghts loads this library first, reports and then aborts.

@@ -119,11 +119,22 @@ class Dem:
     def command(self, cmd: Command) -> None:
         """Run one script command; a refusal names the script's file and line."""
         try:
+            self._before(cmd)
             self._raw(cmd.text)
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()}: {exc}") from None
         self.info.learn(cmd)
         self.report_warnings(cmd)
+
+    def _before(self, cmd: Command) -> None:
+        """What the host added that a valid script command would trip on: LIGGGHTS refuses
+        to unfix a mesh wall while a compute wall/gran/local is active, so the host's goes
+        first (the script's own would stop plain LIGGGHTS too, and stays)."""
+        w = cmd.words
+        if (w[0] == "unfix" and len(w) == 2 and self.info.wall_compute is not None
+                and self.info.wall_compute[0] == WALL_COMPUTE and getattr(self.info.walls.get(w[1]), "meshes", None)):
+            self._raw(f"uncompute {WALL_COMPUTE}")
+            self.info.wall_compute = None
 
     def report_warnings(self, cmd: Command | None = None) -> None:
         """LIGGGHTS' own warnings since the last report, on screen once each (they used to stay

@@ -10,9 +10,12 @@ array of a ``fix external pf/array`` for per-atom forces set from Python.
 LIGGGHTS ends its process on any error (``exit(1)``). So every command, input file and the
 first run after a change is tried first in a forked copy of this process: when the copy
 dies, :class:`LiggghtsError` carries LIGGGHTS' own ``ERROR`` line and this process goes on
-unharmed. Later run chunks are not tried (a fork costs milliseconds, a chunk microseconds);
-if one of them fails, the helper prints LIGGGHTS' message to stderr before the process
-ends. Units are whatever the input sets; the project uses ``units si`` (m, kg, s, K, N).
+unharmed. Later run chunks are not tried (a fork costs milliseconds, a chunk microseconds):
+the helper turns LIGGGHTS' errors into a return with the message (``collheat_command``), so
+a chunk that fails ("Lost atoms", on any rank together) raises :class:`LiggghtsFailed` and
+the caller can still read the atoms and write its summary; the instance then runs nothing
+more. An error raised by one rank alone under MPI still ends the job through MPI_Abort,
+with LIGGGHTS' message on stderr. Units are whatever the input sets; the project uses ``units si`` (m, kg, s, K, N).
 """
 from __future__ import annotations
 
@@ -27,6 +30,8 @@ from pathlib import Path
 from typing import Iterable
 
 import numpy as np
+
+from pyhost.exitcodes import SimulationFailed
 
 LIB = "libliggghts.so.3"
 _ISOLATED = "OMPI_MCA_ess_singleton_isolated"
@@ -51,6 +56,8 @@ _DECLARATIONS = {
 }
 _HELPER_DECLARATIONS = {
     "collheat_watch_exit": (None, [_vp, _cp]),
+    "collheat_command": (_int, [_vp, _cp, _int]),
+    "collheat_failure": (_cp, []),
     "collheat_flush": (None, [_vp]),
     "collheat_set_screen": (_int, [_vp, _cp]),
     "collheat_compute_local": (_int, [_vp, _cp, _c.POINTER(_int), _c.POINTER(_int),
@@ -68,6 +75,11 @@ _ATOM = {
 
 class LiggghtsError(RuntimeError):
     """A LIGGGHTS error, with LIGGGHTS' own message."""
+
+
+class LiggghtsFailed(LiggghtsError, SimulationFailed):
+    """LIGGGHTS stopped with an error during a run chunk that had started (e.g. "Lost atoms"):
+    a failed simulation (exit 3), not bad input."""
 
 
 def _declare(lib: ctypes.CDLL, table: dict) -> None:
@@ -155,6 +167,7 @@ class Liggghts:
             args += [b"-var", str(name).encode(), str(value).encode()]
         argv = (_cp * len(args))(*args)
         self.ptr = _vp()
+        self.failed: str | None = None   # LIGGGHTS' error that left this instance mid-command
         self._changed = True  # a command since the last run: try the next run first
         if self.comm is not None:
             from mpi4py import MPI
@@ -204,8 +217,8 @@ class Liggghts:
         """Execute one LIGGGHTS command; raise LiggghtsError with LIGGGHTS' message."""
         if line.split()[:1] == ["include"]:
             raise LiggghtsError("'include' does nothing through the C API: use Liggghts.file()")
-        self._tried(lambda: self.lib.lammps_command(self.ptr, line.encode()), line)
-        self.lib.lammps_command(self.ptr, line.encode())
+        self._tried(lambda: self._call(line), line)
+        self._execute(line, LiggghtsError)
         self._changed = True
 
     def commands(self, lines: Iterable[str] | str) -> None:
@@ -222,8 +235,8 @@ class Liggghts:
         path = Path(path)
         if not path.is_file():
             raise LiggghtsError(f"LIGGGHTS input {path} does not exist")
-        self._tried(lambda: self.lib.lammps_file(self.ptr, str(path).encode()), f"file {path}")
-        self.lib.lammps_file(self.ptr, str(path).encode())
+        self._tried(lambda: self._call(str(path), is_file=True), f"file {path}")
+        self._execute(str(path), LiggghtsError, is_file=True)
         self._changed = True
 
     def run(self, steps: int) -> None:
@@ -233,9 +246,21 @@ class Liggghts:
             raise ValueError(f"steps must be >= 0, got {steps}")
         line = f"run {steps} post no" if self._changed else f"run {steps} pre no post no"
         if self._changed:
-            self._tried(lambda: self.lib.lammps_command(self.ptr, line.encode()), line)
-        self.lib.lammps_command(self.ptr, line.encode())
+            self._tried(lambda: self._call(line), line)
+        self._execute(line, LiggghtsFailed, what="during the run, at step {step}")
         self._changed = False
+
+    def _call(self, line: str, is_file: bool = False) -> int:
+        """One command (or input file) through the helper: 0, or 1 when LIGGGHTS reported
+        an error (``collheat_failure``) and returned instead of ending the process."""
+        return self.helper.collheat_command(self.ptr, line.encode(), int(is_file))
+
+    def _execute(self, line: str, error: type, is_file: bool = False, what: str | None = None) -> None:
+        if self.failed:
+            raise LiggghtsError(f"LIGGGHTS stopped at an earlier error and runs nothing more: {self.failed}")
+        if self._call(line, is_file):
+            self.failed = (self.helper.collheat_failure() or b"").decode(errors="replace").strip() or "no message"
+            raise error(f"{(what or repr(line)).format(step=self.step)}: {self.failed}")
 
     def _tried(self, call, what: str) -> None:
         """Run ``call`` in a forked copy of this process, its LIGGGHTS output going to a
@@ -253,10 +278,11 @@ class Liggghts:
                 try:
                     self.helper.collheat_watch_exit(self.ptr, b"")  # the parent reports, not the copy
                     self.helper.collheat_set_screen(self.ptr, str(trial).encode())
-                    call()
+                    failed = call()
                     self.helper.collheat_flush(self.ptr)
+                    os._exit(1 if failed else 0)
                 finally:
-                    os._exit(0)
+                    os._exit(1)
             status = self._wait_trial(pid, trial)
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, mask)
@@ -437,7 +463,8 @@ class Liggghts:
     def close(self) -> None:
         if self.ptr:
             self.helper.collheat_watch_exit(None, b"")
-            self.lib.lammps_close(self.ptr)
+            if not self.failed:          # one left mid-command is not taken apart: its memory goes with the process
+                self.lib.lammps_close(self.ptr)
             self.ptr = _vp()
         if self._tmp is not None:
             self._tmp.cleanup()

@@ -148,8 +148,11 @@ def collective(method):
 
     @functools.wraps(method)
     def wrapper(self, *args, **kwargs):
+        from pyhost.engines.liggghts import LiggghtsFailed
         try:
             return method(self, *args, **kwargs)
+        except LiggghtsFailed:
+            raise                 # every rank's LIGGGHTS returned with it (Error::all): still in step
         except BaseException:
             if self.link is not None:
                 self.link.broken = True
@@ -195,7 +198,11 @@ class Follower:
         self.lmp.command(line)
 
     def do_run(self, steps) -> None:
-        self.lmp.run(steps)
+        from pyhost.engines.liggghts import LiggghtsFailed
+        try:
+            self.lmp.run(steps)
+        except LiggghtsFailed:
+            pass                  # rank 0 has the same error and reports it; orders go on
 
     def do_variable(self, name) -> None:
         self.lmp.variable(name)

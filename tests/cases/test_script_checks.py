@@ -2,6 +2,8 @@
 adapt, as Debian's packing tutorial), a fix heat/gran defined after the first run (as CFDEM's
 packedBedTemp), materials of types the script does not create, particles at 0 K."""
 import json
+import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -74,11 +76,14 @@ pictures = false
 """
 
 
-def run(tmp_path, script, case_toml, *options):
+def run(tmp_path, script, case_toml, *options, ranks=1):
     (tmp_path / "in.run").write_text(script)
     (tmp_path / "case.toml").write_text(case_toml)
-    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out"), *options],
-                       capture_output=True, text=True, cwd=ROOT, timeout=600)
+    cmd = [sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out"), *options]
+    if ranks > 1:
+        cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
     summary = tmp_path / "out" / "summary.json"
     return r, json.loads(summary.read_text()) if summary.exists() else None
 
@@ -185,3 +190,98 @@ def test_a_type_without_material_mid_run_still_leaves_a_summary(tmp_path):
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
     assert "atom type(s) [2] have no material" in r.stderr
     assert s is not None and s["status"].startswith("stopped at t = ") and s["steps"] == 200
+
+
+LOSE = """create_atoms 1 single 0.01 0.01 0.01 units box
+create_atoms 1 single 0.005 0.01 0.01 units box
+set type 1 diameter 0.002 density 2500
+fix integr all nve/sphere
+thermo_modify lost error
+thermo 10
+run 200
+velocity all set 20.0 0 0
+run 5000
+"""
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_lost_atoms_in_a_later_chunk_end_with_a_summary(tmp_path, ranks):
+    """Spheres thrown out through an open face in the middle of a long run, with the
+    script's 'thermo_modify lost error': LIGGGHTS' "Lost atoms" error comes in a chunk that was
+    not tried in a forked copy. It used to end the process (exit 1, no summary.json; under
+    mpirun with no script line); now exit 3 naming the script's line and LIGGGHTS' message,
+    with the summary of the steps done, on one rank and on two."""
+    if ranks > 1 and shutil.which("mpirun") is None:
+        pytest.fail("no mpirun: tools/setup.sh --engines installs it")
+    script = HEAD.split("region fill")[0].format(types=1, E="5e6", nu="0.3", e="0.5", mu="0.5") + LOSE
+    r, s = run(tmp_path, script, toml(), ranks=ranks)
+    assert r.returncode == 3, r.stdout[-3000:] + r.stderr[-3000:]
+    last = len(script.splitlines())
+    assert f"in.run:{last}: during the run, at step " in r.stderr and "ERROR: Lost atoms" in r.stderr
+    assert s is not None and s["status"].startswith("stopped at t = ")
+    # 20 m/s from x = 0.005 m over 0.015 m to the open face: gone by step 200 + 75 (thermo every 10)
+    assert 200 < s["steps"] <= 200 + 75 + 10, s["steps"]
+
+
+FLOOR = """solid floor
+facet normal 0 0 1
+outer loop
+vertex 0 0 0.001
+vertex 0.02 0 0.001
+vertex 0.02 0.02 0.001
+endloop
+endfacet
+facet normal 0 0 1
+outer loop
+vertex 0 0 0.001
+vertex 0.02 0.02 0.001
+vertex 0 0.02 0.001
+endloop
+endfacet
+endsolid floor
+"""
+
+
+def test_a_script_may_unfix_its_mesh_wall(tmp_path):
+    """A mesh floor that the script removes between runs (valid in plain LIGGGHTS): the
+    compute wall/gran/local the host adds for it used to make the 'unfix' fail. Particles
+    fall on the floor (collisions with it are seen), the floor goes, they fall to the
+    primitive wall below."""
+    (tmp_path / "floor.stl").write_text(FLOOR)
+    head = header().replace("fix walls all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n",
+                            "fix gravi all gravity 9.81 vector 0 0 -1\n"
+                            "fix cad all mesh/surface file floor.stl type 1\n"
+                            "fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n"
+                            "fix walls all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n")
+    r, s = run(tmp_path, head + "run 3000\nunfix floor\nrun 1000\n", toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert s["particle_wall"] > 0 and s["steps"] == 4000
+    assert abs(s["energy_balance_error"]) < 1e-9
+
+
+def test_the_scripts_own_dumps_have_the_frames_of_a_native_run(tmp_path):
+    """A script's 'dump local' and 'dump custom', with heat/gran and a run of ${n} steps: the
+    host's run writes the same frames (time steps) as 'liggghts -in' does, none twice (the
+    issue catalogue reported two duplicate frames)."""
+    if shutil.which("liggghts") is None:
+        pytest.fail("no liggghts: tools/setup.sh --engines installs it")
+    heat = ("fix m5 all property/global thermalConductivity peratomtype 1.0\n"
+            "fix m6 all property/global thermalCapacity peratomtype 840\n"
+            "fix ht all heat/gran initial_temperature 300\nfix integr")
+    script = header().replace("fix integr", heat) + (
+        "compute cp all pair/gran/local pos vel id delta\n"
+        "dump dl all local 100 pair.dump c_cp[1] c_cp[2]\ndump da all custom 100 atoms.dump id x y z\n"
+        "variable n equal 1000\nrun ${n}\nrun 500\n")
+    native = tmp_path / "native"
+    native.mkdir()
+    (native / "in.run").write_text(script)
+    subprocess.run(["liggghts", "-in", "in.run", "-log", "none", "-screen", "/dev/null"], cwd=native, check=True,
+                   timeout=300)
+    r, s = run(tmp_path, script, toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    def steps(dump):
+        lines = dump.read_text().splitlines()
+        return [lines[k + 1] for k, ln in enumerate(lines) if ln == "ITEM: TIMESTEP"]
+
+    for name in ("pair.dump", "atoms.dump"):
+        assert steps(tmp_path / name) == steps(native / name) == [str(k) for k in range(0, 1501, 100)]
