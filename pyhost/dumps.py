@@ -517,6 +517,8 @@ class DumpReader:
             raise error(f"file ends after {len(body)} rows of {n} (truncated)", first + len(body))
         if kind == "atoms":
             self._check_atoms(data, columns, lambda problem, row: error(problem, first + row))
+        elif groups:
+            self._check_local(data, columns, groups, lambda problem, row: error(problem, first + row))
         time = None if self.dt is None else step * self.dt
         periodic = tuple(b == "pp" for b in bounds)
         return Frame(str(path), start, step, time, box, periodic, tuple(columns), data, kind, groups)
@@ -554,6 +556,7 @@ class DumpReader:
             meaning.append(known[col - 1])
         if len(styles) > 1:
             raise error("one dump mixes pair/gran/local and wall/gran/local columns")
+        self._check_cut(columns, error)
         groups = {}
         for k, (name, comp) in enumerate(meaning):
             groups.setdefault(name, {})[comp] = k
@@ -561,6 +564,41 @@ class DumpReader:
                   for name, parts in groups.items() if None in parts or len(parts) == 3}
         kind = "local" if not styles else ("wall" if styles == {"wall/gran/local"} else "pair")
         return kind, layout
+
+    def _check_cut(self, columns, error) -> None:
+        """A dump that lists a compute's columns 1..N where N ends inside one of its keyword's
+        groups (5 of the 6 'vel' columns): written by a compute of other keywords than the
+        ones given (a user dumps whole groups)."""
+        listed = {}
+        for name in columns:
+            if m := re.fullmatch(r"c_([^\[\]]+)\[(\d+)\]", name):
+                listed.setdefault(m.group(1), []).append(int(m.group(2)))
+        for cid, cols in listed.items():
+            known = [c for c in self.computes[cid].columns() if c[0] is not None]
+            n = len(cols)
+            if sorted(cols) == list(range(1, n + 1)) and n < len(known) and known[n - 1][0] == known[n][0]:
+                compute = self.computes[cid]
+                raise error(f"the dump has columns 1-{n} of compute {cid}, which ends inside its "
+                            f"'{known[n][0]}' columns by the keywords {compute.style} {' '.join(compute.keywords)} "
+                            f"({len(known)} columns): the keywords (--script, --compute) are not those of the "
+                            "compute that wrote this dump")
+
+    # columns that hold whole numbers, and their least value, whatever the compute's keywords
+    _WHOLE = {"id_i": 1, "id_j": 1, "periodic": 0, "mesh": 0, "triangle": 0}
+
+    def _check_local(self, data, columns, groups, error) -> None:
+        """Contact rows read by the computes' keywords (from --script or --compute) must hold
+        ids where the keywords place them: keywords that are not those the dump was written
+        with would otherwise reinterpret its columns without a word."""
+        for name, least in self._WHOLE.items():
+            k = groups.get(name)
+            if not isinstance(k, int) or not len(data):
+                continue
+            bad = np.flatnonzero((data[:, k] != np.round(data[:, k])) | (data[:, k] < least))
+            if len(bad):
+                raise error(f"column {columns[k]} should hold {name} by the compute's keywords, but holds "
+                            f"{data[bad[0], k]:g}: the keywords (--script, --compute) are not those of the "
+                            "compute that wrote this dump", bad[0])
 
     def _check_atoms(self, data, columns, error) -> None:
         if "radius" in columns:

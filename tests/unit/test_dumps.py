@@ -206,3 +206,30 @@ def test_memory_stays_per_frame(tmp_path):
     tracemalloc.stop()
     assert frames == 200
     assert peak < path.stat().st_size / 10, (peak, path.stat().st_size)
+
+
+def test_keywords_that_do_not_match_the_dump_are_an_error(tmp_path):
+    """The dump was written by 'pair/gran/local id delta' (ids in columns 1-3); keywords
+    'pos id delta' given by --script place the ids in columns 7-9, where this dump has none:
+    refused naming the column (they used to be read as positions silently)."""
+    rows = ["1 2 0 1e-5 0 0 0 0 0", "3 4 0 2e-5 0 0 0 0 0"]
+    cols = [f"c_c[{k}]" for k in range(1, 10)]
+    (tmp_path / "l").write_text(local_dump(cols[:4], [r[:r.index(" 0 0 0 0 0")] for r in rows]))
+    good = list(DumpReader([tmp_path / "l"], computes={"c": Compute("c", "pair/gran/local", ("id", "delta"))}))
+    assert good[0].data[:, 0].tolist() == [1, 3]
+    (tmp_path / "l").write_text(local_dump(cols[:9], ["0.1 0.2 0.3 0.4 0.5 0.6 1.5 2 0", "0 0 0 0 0 0 1 2 0"]))
+    with pytest.raises(DumpError, match=r"column c_c\[7\] should hold id_i .* holds 1.5"):
+        list(DumpReader([tmp_path / "l"], computes={"c": Compute("c", "pair/gran/local", ("pos", "id", "delta"))}))
+
+
+def test_a_dump_cut_inside_a_keywords_columns_is_an_error(tmp_path):
+    """A dump written by 'pair/gran/local vel id contactArea delta' (11 columns) read with the
+    keywords 'pos vel id delta' of an edited script (16): its 11 columns would end inside
+    v_j and hold no ids; refused, naming the compute and both widths."""
+    cols = [f"c_c[{k}]" for k in range(1, 12)]
+    (tmp_path / "l").write_text(local_dump(cols, ["0.1 0 0 0 0 0 1 2 0 3e-6 1e-5"]))
+    with pytest.raises(DumpError, match=r"columns 1-11 of compute c, which ends inside its 'v_j' .*16 columns"):
+        list(DumpReader([tmp_path / "l"], computes={"c": Compute("c", "pair/gran/local", ("pos", "vel", "id", "delta"))}))
+    frames = list(DumpReader([tmp_path / "l"], computes={"c": Compute("c", "pair/gran/local",
+                                                                      ("vel", "id", "contactArea", "delta"))}))
+    assert frames[0].groups["id_i"] == 6 and frames[0].data[0, 6] == 1
