@@ -152,6 +152,7 @@ class Post:
         self.unplaced = set()            # scene walls whose primitive plane post cannot place (warned)
         self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()
+        self.positions = {}             # step -> (ids, x, box, periodic) of a few particle frames
         self.summary = dict(frames=0, particles=0, collisions=dict(particle_particle=0, particle_wall=0),
                             heat_J={m: 0.0 for m in self.models}, warnings=self.warnings, complete=False)
         self.stop_step = None            # the last good step before a failure: nothing after it is used
@@ -202,6 +203,8 @@ class Post:
             column = next((c for c in ("f_Temp", *(f"f_{h}" for h in (self.script.heat_gran if self.script else ())))
                            if c in f), None)
             self.particles.add(ids, types, f["radius"], f[column] if column else None)
+            if self.contacts and len(self.positions) < 8:       # a few frames to check contact dumps against
+                self.positions[f.step] = (ids, f.positions(), self.frame_box(f), f.periodic)
             steps.append(f.step)
             last = f
             if not self.contacts:
@@ -305,8 +308,36 @@ class Post:
                              f"to needs exactly one wall with 'fix', or --script; {len(fixes)} have one")
         return fixes[0]
 
+    def check_same_run(self, f, ids_i) -> None:
+        """A contact frame at a step the particle dumps also have: its particles must be where
+        those dumps put them (contact dumps of another run with the same ids would otherwise
+        be taken for this one's). Tolerance: the dumps' 6 significant digits."""
+        if f.step not in self.positions:
+            return
+        ids, x, box, periodic = self.positions.pop(f.step)
+        at = np.full(int(max(ids.max(initial=0), ids_i.max(initial=0))) + 1, -1)
+        at[ids] = np.arange(len(ids))
+        rows = at[ids_i]
+        seen = rows >= 0
+        d = f.vector("x_i")[seen] - x[rows[seen]]
+        if box is not None:
+            size = box[:, 1] - box[:, 0]
+            d -= np.where(periodic, size * np.round(d / size), 0.0)
+            scale = np.abs(box).max()
+        else:
+            scale = np.abs(x).max(initial=0.0)
+        tol = 1e-5 * scale + 1e-3 * self.particles.radius[ids_i[seen]]
+        far = np.flatnonzero(np.linalg.norm(d, axis=1) > tol)
+        if len(far):
+            k = far[0]
+            raise DumpError(f.file, f.step, f.line,
+                            f"particle {ids_i[seen][k]} is at {f.vector('x_i')[seen][k].tolist()} m here and at "
+                            f"{x[rows[seen][k]].tolist()} m in the particle dumps at the same step: the contact "
+                            "dumps are not of the run the particle dumps are of")
+
     def add_dump_contacts(self, f, cid, first, found, window) -> None:
         ids_i = self.checked_ids(f, f["id_i"])
+        self.check_same_run(f, ids_i)
         r_i = self.particles.radius[ids_i]
         if f.kind == "pair":
             ids_j = self.checked_ids(f, f["id_j"])

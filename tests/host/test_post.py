@@ -242,3 +242,28 @@ def test_out_holding_a_run_is_refused(tmp_path):
     r = post(tmp_path / "d.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-5", "--out", tmp_path / "run")
     assert r.returncode == 2 and "holds the output of a run (scene.json)" in r.stderr
     assert json.loads((tmp_path / "run" / "summary.json").read_text()) == {"status": "completed"}
+
+
+@pytest.mark.engines
+def test_contact_dumps_of_another_run_are_refused(pour_dumps, tmp_path):
+    """The same pour with another insertion seed: its contact dumps have the same ids and
+    steps, so they used to be taken for the first run's. Their particles are elsewhere than
+    in the particle dumps at the same step: refused (exit 2) naming the file and step."""
+    other = tmp_path / "other"
+    (other / "post").mkdir(parents=True)
+    (other / "floor.stl").write_text((pour_dumps / "floor.stl").read_text())
+    script = (pour_dumps / "in.pour").read_text().replace("seed 49979687", "seed 86028121")
+    assert script != (pour_dumps / "in.pour").read_text()
+    (other / "in.pour").write_text(script)
+    done = subprocess.run(["liggghts", "-in", "in.pour", "-log", "log.liggghts", "-screen", "/dev/null"], cwd=other,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (other / "log.liggghts").read_text()[-2000:]
+    (tmp_path / "scene.toml").write_text(GLASS + STEEL_WALL)
+    run = post(pour_dumps / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
+               other / "post" / "pair.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / "out")
+    assert run.returncode == 2, run.stderr
+    assert "the contact dumps are not of the run the particle dumps are of" in run.stderr
+    assert "pair." in run.stderr and "timestep" in run.stderr
+    same = post(pour_dumps / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
+                pour_dumps / "post" / "pair.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / "same")
+    assert same.returncode == 0, same.stderr
