@@ -646,6 +646,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     last_run = max((k for k, c in enumerate(commands) if c.name == "run"), default=-1)
     try:
         for k, cmd in enumerate(commands):
+            dem.context(cmd)
             if cmd.name != "run":
                 dem.command(cmd)
                 continue

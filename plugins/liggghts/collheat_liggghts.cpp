@@ -21,6 +21,8 @@
 using namespace LAMMPS_NS;
 
 static char exit_log[4096] = "";
+static char context[1024] = "";      // what the host was running (the script's file and line)
+static bool reported = false;
 static LAMMPS *watched = nullptr;
 
 // On exit(1) from Error::all, or MPI_Abort from Error::one, print LIGGGHTS' last ERROR line
@@ -28,7 +30,7 @@ static LAMMPS *watched = nullptr;
 // without a word. pyhost.liggghts disarms it on a normal exit of Python.
 static void report_exit()
 {
-    if (!exit_log[0]) return;
+    if (!exit_log[0] || reported) return;
     FILE *f = std::fopen(exit_log, "r");
     if (!f) return;
     char line[4096], last[4096] = "";
@@ -36,7 +38,8 @@ static void report_exit()
         if (std::strncmp(line, "ERROR", 5) == 0) std::strcpy(last, line);
     std::fclose(f);
     if (last[0])
-        std::fprintf(stderr, "LIGGGHTS ended the process: %s(log: %s)\n", last, exit_log);
+        std::fprintf(stderr, "LIGGGHTS ended the process%s%s: %s(log: %s)\n", context[0] ? " at " : "", context,
+                     last, exit_log);
 }
 
 // ---- errors that return --------------------------------------------------------------
@@ -122,6 +125,16 @@ void Error::one(const char *file, int line, const char *str)
         std::snprintf(text, sizeof text, "%s (%s:%d)", str, file, line);
         fail_all(world, screen, logfile, text);
     }
+    // Under MPI the rank with the error may have no screen (only rank 0 writes one), and
+    // MPI_Abort ends every rank: say it on this rank's stderr, with what the host was running.
+    if (exit_log[0]) {
+        int me;
+        MPI_Comm_rank(world, &me);
+        std::fprintf(stderr, "LIGGGHTS ended the process%s%s: ERROR on proc %d: %s (%s:%d)\n",
+                     context[0] ? " at " : "", context, me, str, file, line);
+        std::fflush(stderr);
+        reported = true;
+    }
     original<void (*)(Error *, const char *, int, const char *)>(
         "_ZN9LAMMPS_NS5Error3oneEPKciS2_")(this, file, line, str);
     std::abort();
@@ -146,6 +159,12 @@ int collheat_command(void *ptr, const char *line, int is_file)
 }
 
 const char *collheat_failure() { return failure; }
+
+// What the host runs now (e.g. "in.run:27 (run 5000)"), named if LIGGGHTS ends the process.
+void collheat_context(const char *text)
+{
+    std::snprintf(context, sizeof context, "%s", text ? text : "");
+}
 
 // Error::one ends with MPI_Abort, which skips atexit: this definition, found before
 // OpenMPI's because pyhost.liggghts loads this library first, reports and then aborts.

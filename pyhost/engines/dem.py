@@ -136,6 +136,14 @@ class Dem:
             self._raw(f"uncompute {WALL_COMPUTE}")
             self.info.wall_compute = None
 
+    def context(self, cmd: Command) -> None:
+        """The script command under way, on every rank: named if LIGGGHTS ends the process
+        (an error of one rank alone under MPI, which cannot return)."""
+        text = f"{cmd.where()} ({cmd.text[:200]})"
+        if self.link is not None:
+            self._order("context", text)
+        self.lmp.context(text)
+
     def report_warnings(self, cmd: Command | None = None) -> None:
         """LIGGGHTS' own warnings since the last report, on screen once each (they used to stay
         in OUT/dem/log.liggghts): after each script command and each script run."""

@@ -58,6 +58,7 @@ _HELPER_DECLARATIONS = {
     "collheat_watch_exit": (None, [_vp, _cp]),
     "collheat_command": (_int, [_vp, _cp, _int]),
     "collheat_failure": (_cp, []),
+    "collheat_context": (None, [_cp]),
     "collheat_flush": (None, [_vp]),
     "collheat_set_screen": (_int, [_vp, _cp]),
     "collheat_compute_local": (_int, [_vp, _cp, _c.POINTER(_int), _c.POINTER(_int),
@@ -187,6 +188,10 @@ class Liggghts:
             else:
                 os.environ[_ISOLATED] = saved
         self._watch()
+
+    def context(self, text: str) -> None:
+        """What is being run (the script's file and line), named if LIGGGHTS ends the process."""
+        self.helper.collheat_context(text.encode())
 
     def new_warnings(self) -> list[str]:
         """LIGGGHTS' WARNING lines written to its screen log since the last call (rank 0's)."""

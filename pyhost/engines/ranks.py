@@ -197,6 +197,9 @@ class Follower:
     def do_command(self, line) -> None:
         self.lmp.command(line)
 
+    def do_context(self, text) -> None:
+        self.lmp.context(text)
+
     def do_run(self, steps) -> None:
         from pyhost.engines.liggghts import LiggghtsFailed
         try:

@@ -285,3 +285,18 @@ def test_the_scripts_own_dumps_have_the_frames_of_a_native_run(tmp_path):
 
     for name in ("pair.dump", "atoms.dump"):
         assert steps(tmp_path / name) == steps(native / name) == [str(k) for k in range(0, 1501, 100)]
+
+
+def test_an_error_of_one_rank_names_the_script_line(tmp_path):
+    """Under mpirun, an error LIGGGHTS raises on one rank alone (Error::one: a 'fix print'
+    reaching an undefined variable) ends every rank through MPI_Abort and cannot leave a
+    summary; it used to name no script line (and a rank without a screen said nothing). Now
+    stderr has LIGGGHTS' message, the rank, and the script's file, line and command."""
+    if shutil.which("mpirun") is None:
+        pytest.fail("no mpirun: tools/setup.sh --engines installs it")
+    script = header() + 'run 200\nfix pr all print 300 "value ${nothere}"\nrun 5000\n'
+    r, _ = run(tmp_path, script, toml(), ranks=2)
+    assert r.returncode != 0
+    last = len(script.splitlines())
+    assert f"LIGGGHTS ended the process at {tmp_path}/in.run:{last} (run 5000): ERROR on proc" in r.stderr, r.stderr
+    assert "Substitution for illegal variable" in r.stderr
