@@ -1,0 +1,256 @@
+// Contact events recorded inside LIGGGHTS at every DEM step, for pyhost/engines/events.py.
+//
+// The host adds `fix ID all external pf/callback 1 1` and attaches a Recorder to it: LIGGGHTS
+// then calls record() in post_force of every step (and of each run's set-up), after the
+// forces, with x at the end of the step and v at the half step. record() walks the pair
+// style's neighbour list and the host's primitive planes and keeps the set of touching
+// pairs (overlap r_i + r_j - |x_i - x_j| > 0, LIGGGHTS' own contact test). A contact that
+// was not there on the previous call is a BEGIN event with its approach speed
+// vn = -(v_i - v_j) . n [m/s] (n the unit normal from j to i; > 0 while closing in): at the
+// first step in contact v is still the velocity before the contact, since the half-step
+// velocity was updated with the forces of the step before, when they did not touch. A
+// contact gone is an END event with its duration in steps. The host takes the events in
+// batches (collheat_events_take). The fix adds no force: the callback zeroes its array.
+//
+// Keys as pyhost.collisions.contact_keys: (smaller id << 31) | larger id, a wall being
+// WALL_BASE + its index (> every particle id). Under MPI a pair is recorded by the rank that
+// owns the atom of the smaller id (a wall contact by the atom's owner).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <unordered_map>
+#include <vector>
+#include "lammps.h"
+#include "atom.h"
+#include "force.h"
+#include "pair.h"
+#include "neigh_list.h"
+#include "modify.h"
+#include "fix_external.h"
+#include "update.h"
+#include "neighbor.h"
+
+using namespace LAMMPS_NS;
+
+namespace {
+
+enum Kind { PAIR_BEGIN = 0, PAIR_END = 1, WALL_BEGIN = 2, WALL_END = 3 };
+constexpr int ROW = 9;  // kind, step, i, j, vn [m/s], nx, ny, nz, duration [steps]
+
+struct Recorder {
+    LAMMPS *lmp;
+    FixExternal *fix;
+    bool primed = false;                       // false: the next call records contacts, no events
+    std::vector<double> rows;                  // events waiting, ROW doubles each
+    std::vector<int> axis;                     // primitive planes: axis (0, 1, 2), position [m],
+    std::vector<double> position;              // and the partner code the host gives them
+    std::vector<double> code;
+    long long begun = 0, ended = 0;
+
+    // The state of the contacts, laid out like the neighbour list (one slot per entry, in
+    // the order of ilist and each atom's neighbours) and, for the planes, like the local
+    // atoms (plane-major). Both layouts hold from one neighbour build to the next (LIGGGHTS
+    // sorts, exchanges, inserts and deletes atoms only before a build), so between builds a
+    // step costs a distance test per neighbour and no lookup. At a build, the open contacts
+    // are carried over by key.
+    bigint layout = -1;                        // neighbor->ncalls of the layout
+    size_t planes_laid = 0;                    // planes and local atoms in the layout
+    int nlocal_laid = -1;
+    std::vector<uint8_t> touch;                // in contact at the last call
+    std::vector<bigint> since;                 // step of the first call in contact
+    std::vector<uint64_t> key;                 // the contact's key
+    std::unordered_map<uint64_t, bigint> carry;
+
+    void event(int kind, bigint step, double i, double j, double vn, const double *n, double duration)
+    {
+        const double row[ROW] = {double(kind), double(step), i, j, vn, n[0], n[1], n[2], duration};
+        rows.insert(rows.end(), row, row + ROW);
+    }
+
+    // Slot k in contact now (its key k_, ids i and j, approach speed vn, normal n).
+    inline void on(size_t k, bigint step, bool rebuilt, int kind, uint64_t k_, double i, double j, double vn,
+                   const double *n)
+    {
+        if (touch[k] && !rebuilt) return;
+        touch[k] = 1;
+        key[k] = k_;
+        if (rebuilt) {
+            auto it = carry.find(k_);
+            if (it != carry.end()) { since[k] = it->second; carry.erase(it); return; }
+        }
+        since[k] = step;
+        if (primed) { event(kind, step, i, j, vn, n, 0.0); ++begun; }
+    }
+
+    // Slot k not in contact now: an END if it was (between builds; at a build, what is left
+    // in ``carry`` has ended).
+    inline void off(size_t k, bigint step, bool rebuilt)
+    {
+        if (!touch[k]) return;
+        touch[k] = 0;
+        if (!rebuilt) end(key[k], since[k], step);
+    }
+
+    void end(uint64_t k_, bigint start, bigint step)
+    {
+        if (!primed) return;
+        const uint64_t lo = k_ >> 31, hi = k_ & ((uint64_t(1) << 31) - 1);
+        const bool wall = hi >= (uint64_t(1) << 30);
+        const double none[3] = {0, 0, 0};
+        event(wall ? WALL_END : PAIR_END, step, double(lo), double(hi), 0.0, none, double(step - start));
+        ++ended;
+    }
+
+    void record(bigint step)
+    {
+        Atom *atom = lmp->atom;
+        const int nlocal = atom->nlocal;
+        double **x = atom->x, **v = atom->v;
+        const double *r = atom->radius;
+        const int *tag = atom->tag;
+        Pair *pair = lmp->force->pair;
+        NeighList *list = pair ? pair->list : nullptr;
+        const bool have_list = list && list->ilist;
+        // a new layout at each neighbour build (or new planes): the slots counted then only
+        const bool rebuilt = lmp->neighbor->ncalls != layout || axis.size() != planes_laid || nlocal != nlocal_laid;
+        if (rebuilt) {                         // the open contacts, by key, into the new layout
+            size_t slots = 0;
+            if (have_list)
+                for (int ii = 0; ii < list->inum; ++ii) slots += list->numneigh[list->ilist[ii]];
+            slots += axis.size() * size_t(nlocal);
+            planes_laid = axis.size();
+            nlocal_laid = nlocal;
+            carry.clear();
+            for (size_t k = 0; k < touch.size(); ++k)
+                if (touch[k]) carry.emplace(key[k], since[k]);
+            touch.assign(slots, 0);
+            since.resize(slots);
+            key.resize(slots);
+            layout = lmp->neighbor->ncalls;
+        }
+        size_t k = 0;
+        if (have_list) {
+            NeighList *hist = pair->listgranhistory;        // LIGGGHTS' own contact flags, if it keeps them
+            const bool flags = hist && hist->firstneigh && !rebuilt;
+            for (int ii = 0; ii < list->inum; ++ii) {
+                const int i = list->ilist[ii];
+                const int *jlist = list->firstneigh[i];
+                const int jnum = list->numneigh[i];
+                const int *flag = flags ? hist->firstneigh[i] : nullptr;
+                for (int jj = 0; jj < jnum; ++jj, ++k) {
+                    // between builds, a pair LIGGGHTS holds apart now and held apart before needs no test
+                    if (flag && !flag[jj] && !touch[k]) continue;
+                    const int j = jlist[jj] & NEIGHMASK;
+                    const double d[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
+                    const double rsq = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    const double radsum = r[i] + r[j];
+                    // recorded once: a pair of two local atoms as listed; a pair with a ghost (an
+                    // atom of another rank, or a periodic image) by the owner of the smaller id
+                    if (rsq >= radsum * radsum || (j >= nlocal && tag[i] > tag[j])) { off(k, step, rebuilt); continue; }
+                    if (touch[k] && !rebuilt) continue;
+                    const bool i_first = tag[i] < tag[j];
+                    const int lo = i_first ? i : j, hi = i_first ? j : i;
+                    const double dist = std::sqrt(rsq);
+                    const double s = (i_first ? 1.0 : -1.0) / (dist > 0 ? dist : 1.0);
+                    const double n[3] = {d[0] * s, d[1] * s, d[2] * s};       // from hi to lo
+                    const double vn = -((v[lo][0] - v[hi][0]) * n[0] + (v[lo][1] - v[hi][1]) * n[1] +
+                                        (v[lo][2] - v[hi][2]) * n[2]);
+                    on(k, step, rebuilt, PAIR_BEGIN, (uint64_t(tag[lo]) << 31) | uint64_t(tag[hi]),
+                       tag[lo], tag[hi], vn, n);
+                }
+            }
+        }
+        for (size_t w = 0; w < axis.size(); ++w) {
+            const int a = axis[w];
+            for (int i = 0; i < nlocal; ++i, ++k) {
+                const double gap = x[i][a] - position[w];
+                if (r[i] - std::fabs(gap) <= 0) { off(k, step, rebuilt); continue; }
+                if (touch[k] && !rebuilt) continue;
+                double n[3] = {0, 0, 0};
+                n[a] = gap >= 0 ? 1.0 : -1.0;                                  // from the wall to the particle
+                on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(code[w]), tag[i], code[w],
+                   -v[i][a] * n[a], n);
+            }
+        }
+        if (rebuilt) {                         // contacts of the old layout not found again: ended
+            for (const auto &c : carry) end(c.first, c.second, step);
+            carry.clear();
+        }
+        primed = true;
+    }
+
+    long long open_count() const
+    {
+        long long n = 0;
+        for (uint8_t t : touch) n += t;
+        return n;
+    }
+};
+
+}  // namespace
+
+namespace {
+
+void callback(void *ptr, bigint step, int nlocal, int *, double **, double **f)
+{
+    Recorder *rec = static_cast<Recorder *>(ptr);
+    if (nlocal > 0 && f) std::memset(f[0], 0, sizeof(double) * 3 * nlocal);   // adds no force
+    rec->record(step);
+}
+
+}  // namespace
+
+extern "C" {
+
+// Attach a Recorder to `fix <fix_id> all external pf/callback 1 1`; null if there is no such fix.
+void *collheat_events_attach(void *ptr, const char *fix_id)
+{
+    LAMMPS *lmp = static_cast<LAMMPS *>(ptr);
+    int k = lmp->modify->find_fix(fix_id);
+    if (k < 0 || std::strcmp(lmp->modify->fix[k]->style, "external") != 0) return nullptr;
+    Recorder *rec = new Recorder;
+    rec->lmp = lmp;
+    rec->fix = static_cast<FixExternal *>(lmp->modify->fix[k]);
+    rec->fix->set_callback(callback, rec);
+    return rec;
+}
+
+// The host's primitive planes: n of them, each an axis (0, 1, 2), a position [m] and the
+// partner code of its contacts (WALL_BASE + the host's wall index).
+void collheat_events_planes(void *handle, int n, const int *axis, const double *position, const double *code)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    rec->axis.assign(axis, axis + n);
+    rec->position.assign(position, position + n);
+    rec->code.assign(code, code + n);
+}
+
+// The next call records the contacts present as open, with no BEGIN events (a start or restart).
+void collheat_events_prime(void *handle) { static_cast<Recorder *>(handle)->primed = false; }
+
+// Events waiting, open contacts now, and all BEGIN and END events recorded so far.
+int collheat_events_waiting(void *handle) { return int(static_cast<Recorder *>(handle)->rows.size() / ROW); }
+int collheat_events_open(void *handle) { return int(static_cast<Recorder *>(handle)->open_count()); }
+long long collheat_events_total(void *handle, int ended)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    return ended ? rec->ended : rec->begun;
+}
+
+// Copy up to max_rows waiting events (ROW doubles each, oldest first) into out and drop them;
+// returns the number copied.
+int collheat_events_take(void *handle, double *out, int max_rows)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    const int n = std::min<int>(max_rows, int(rec->rows.size() / ROW));
+    std::memcpy(out, rec->rows.data(), sizeof(double) * ROW * n);
+    rec->rows.erase(rec->rows.begin(), rec->rows.begin() + ROW * n);
+    return n;
+}
+
+// Detach: the fix keeps a callback that does nothing harmful only while the Recorder lives,
+// so this is for the end of the LIGGGHTS instance.
+void collheat_events_free(void *handle) { delete static_cast<Recorder *>(handle); }
+
+}

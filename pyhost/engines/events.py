@@ -1,0 +1,102 @@
+"""Contact events recorded inside LIGGGHTS at every DEM step (``plugins/liggghts/contact_events.cpp``).
+
+``ContactEvents(lmp)`` adds ``fix collheat_events all external pf/callback 1 1`` and attaches
+the helper's recorder to it: from the next run on, every step (in compiled code, no Python)
+notes each particle-particle contact and each contact with the host's primitive planes that
+begins or ends. ``take()`` hands the events over in a batch, as a numpy structured array of
+``EVENT``: kind (``BEGIN`` or ``END``), step, i and j (atom ids, the smaller first; j is
+WALL_BASE + wall index for a wall), vn, the approach speed at the first step in contact [m/s]
+(the relative normal velocity before any contact force acted: the impact speed), the unit
+normal n from j to i, and for an END the contact's duration in steps. Units SI.
+"""
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+
+FIX = "collheat_events"
+ROW = 9
+BEGIN, END = 0, 1
+EVENT = np.dtype([("kind", np.int8), ("wall", np.bool_), ("step", np.int64), ("i", np.int64), ("j", np.int64),
+                  ("vn", float), ("n", float, 3), ("duration", np.int64)])
+
+_c = ctypes
+_vp, _int, _dp = _c.c_void_p, _c.c_int, _c.POINTER(_c.c_double)
+_DECLARATIONS = {
+    "collheat_events_attach": (_vp, [_vp, _c.c_char_p]),
+    "collheat_events_planes": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp]),
+    "collheat_events_prime": (None, [_vp]),
+    "collheat_events_waiting": (_int, [_vp]),
+    "collheat_events_open": (_int, [_vp]),
+    "collheat_events_total": (_c.c_longlong, [_vp, _int]),
+    "collheat_events_take": (_int, [_vp, _dp, _int]),
+    "collheat_events_free": (None, [_vp]),
+}
+
+
+class ContactEvents:
+    """The contact events of one LIGGGHTS instance (``pyhost.engines.liggghts.Liggghts``),
+    serial. Create it before the run whose contacts it should follow: the contacts present at
+    that run's set-up are open contacts, not events (see :meth:`prime`)."""
+
+    def __init__(self, lmp, fix: str = FIX):
+        self.lmp, self.fix = lmp, fix
+        h = lmp.helper
+        for name, (restype, argtypes) in _DECLARATIONS.items():
+            fn = getattr(h, name)
+            fn.restype, fn.argtypes = restype, argtypes
+        lmp.command(f"fix {fix} all external pf/callback 1 1")
+        self.handle = h.collheat_events_attach(lmp.ptr, fix.encode())
+        if not self.handle:
+            raise RuntimeError(f"could not attach the contact event recorder to fix {fix}")
+
+    def planes(self, axes, positions, codes) -> None:
+        """Primitive plane walls: axis (0, 1, 2 for x, y, z), position [m], and the partner
+        code (WALL_BASE + wall index) of each."""
+        axes = np.ascontiguousarray(axes, dtype=np.intc)
+        positions = np.ascontiguousarray(positions, dtype=float)
+        codes = np.ascontiguousarray(codes, dtype=float)
+        self.lmp.helper.collheat_events_planes(self.handle, len(axes), axes.ctypes.data_as(_c.POINTER(_int)),
+                                               positions.ctypes.data_as(_dp), codes.ctypes.data_as(_dp))
+
+    def prime(self) -> None:
+        """The next step records the contacts there as open, without events (a (re)start)."""
+        self.lmp.helper.collheat_events_prime(self.handle)
+
+    @property
+    def waiting(self) -> int:
+        return self.lmp.helper.collheat_events_waiting(self.handle)
+
+    @property
+    def open_count(self) -> int:
+        """Contacts open now."""
+        return self.lmp.helper.collheat_events_open(self.handle)
+
+    def totals(self) -> tuple[int, int]:
+        """(begun, ended): events recorded since the recorder was attached."""
+        h = self.lmp.helper
+        return h.collheat_events_total(self.handle, 0), h.collheat_events_total(self.handle, 1)
+
+    def take(self) -> np.ndarray:
+        """The events waiting, oldest first, as an array of ``EVENT``; the recorder forgets them."""
+        n = self.waiting
+        raw = np.empty((n, ROW))
+        if n:
+            got = self.lmp.helper.collheat_events_take(self.handle, raw.ctypes.data_as(_dp), n)
+            raw = raw[:got]
+        out = np.empty(len(raw), EVENT)
+        kind = raw[:, 0].astype(int)
+        out["kind"] = kind % 2
+        out["wall"] = kind >= 2
+        out["step"] = raw[:, 1]
+        out["i"], out["j"] = raw[:, 2], raw[:, 3]
+        out["vn"] = raw[:, 4]
+        out["n"] = raw[:, 5:8]
+        out["duration"] = raw[:, 8]
+        return out
+
+    def close(self) -> None:
+        if self.handle:
+            self.lmp.helper.collheat_events_free(self.handle)
+            self.handle = None

@@ -1,0 +1,149 @@
+"""Contact events recorded inside LIGGGHTS at every step (plugins/liggghts/contact_events.cpp,
+pyhost.engines.events) on the real engine, against closed forms and LIGGGHTS' own contact list."""
+import math
+
+import numpy as np
+import pytest
+
+from pyhost.collisions import WALL_BASE
+from pyhost.engines.events import BEGIN, END, ContactEvents
+from pyhost.engines.liggghts import Liggghts, granular_box
+
+pytestmark = pytest.mark.engines
+
+R, RHO, E, NU = 1e-3, 2500.0, 5e6, 0.3          # m, kg/m^3, Pa, -
+DT = 1e-6                                       # s
+
+
+def hertz_contact_time(v_rel: float, wall: bool = False) -> float:
+    """Elastic Hertz impact duration [s] of two equal spheres (or one on a wall of the same
+    material), Johnson (1985) eq. 11.24."""
+    m_eff = RHO * 4 / 3 * math.pi * R**3 * (1.0 if wall else 0.5)
+    r_eff = R if wall else R / 2
+    e_eff = E / (2 * (1 - NU**2))
+    return 2.8683 * (m_eff**2 / (r_eff * e_eff**2 * v_rel)) ** 0.2
+
+
+def box(tmp_path, lo=(-0.01,) * 3, hi=(0.01,) * 3, dt=DT) -> Liggghts:
+    lg = Liggghts(tmp_path)
+    lg.commands(granular_box(lo, hi, youngs=E, poisson=NU, restitution=1.0, friction=0.5, skin=R / 2, dt=dt))
+    return lg
+
+
+def test_a_head_on_pair_gives_one_begin_at_its_impact_speed_and_one_end_after_the_hertz_time(tmp_path):
+    V = 1.0                                     # m/s each
+    with box(tmp_path) as lg:
+        lg.commands(f"""
+            create_atoms 1 single {-1.5 * R} 0 0 units box
+            create_atoms 1 single {1.5 * R} 0 0 units box
+            set atom 1 diameter {2 * R} density {RHO} vx {V}
+            set atom 2 diameter {2 * R} density {RHO} vx {-V}
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        lg.run(1500)
+        got = ev.take()
+    begin, end = got[got["kind"] == BEGIN], got[got["kind"] == END]
+    assert len(begin) == 1 and len(end) == 1
+    b = begin[0]
+    assert (b["i"], b["j"], bool(b["wall"])) == (1, 2, False)
+    # before the first overlap no force has acted: vn is the approach speed 2V to round-off
+    assert b["vn"] == pytest.approx(2 * V, rel=1e-12)
+    assert np.allclose(b["n"], [-1.0, 0.0, 0.0], atol=1e-12)        # from 2 (at +x) to 1
+    # they first overlap after (3R - 2R)/(2V) = R/(2V) = 500 steps
+    assert b["step"] == math.floor(R / (2 * V) / DT) + 1
+    expected = hertz_contact_time(2 * V) / DT
+    print(f"duration {end[0]['duration']} steps, Hertz {expected:.1f}")
+    assert abs(end[0]["duration"] - expected) <= 0.01 * expected + 1
+
+
+def test_a_sphere_dropped_on_a_plane_begins_at_the_free_fall_speed(tmp_path):
+    h = 0.005                                   # m of free fall to the plane
+    with box(tmp_path, dt=1e-6) as lg:
+        lg.commands(f"""
+            fix floor all wall/gran model hertz tangential history primitive type 1 zplane -0.01
+            fix gravi all gravity 9.81 vector 0 0 -1
+            create_atoms 1 single 0 0 {-0.01 + R + h} units box
+            set atom 1 diameter {2 * R} density {RHO}
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        ev.planes([2], [-0.01], [WALL_BASE + 0])
+        lg.run(40000)
+        got = ev.take()
+    begin = got[got["kind"] == BEGIN]
+    assert len(begin) >= 1 and bool(begin[0]["wall"]) and begin[0]["j"] == WALL_BASE
+    v = math.sqrt(2 * 9.81 * h)
+    print(f"vn {begin[0]['vn']:.6f} m/s, sqrt(2 g h) {v:.6f}")
+    # the step's discrete fall: within g dt of the exact speed and of the overlap's depth
+    assert begin[0]["vn"] == pytest.approx(v, rel=1e-3)
+    assert np.allclose(begin[0]["n"], [0, 0, 1])
+
+
+def test_events_follow_liggghts_own_contact_list_step_by_step(tmp_path):
+    """A pile of 200 spheres settling: at every step, the pairs begun are exactly the pairs
+    that compute pair/gran/local lists now and did not list on the step before, and the ended
+    ones those it no longer lists."""
+    with box(tmp_path, lo=(0, 0, 0), hi=(0.02, 0.02, 0.04), dt=1e-5) as lg:
+        lg.commands("""
+            fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+            fix gravi all gravity 9.81 vector 0 0 -1
+            region fill block 0.001 0.019 0.001 0.019 0.001 0.039 units box
+            fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
+            fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+            fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 -0.3 insert_every once overlapcheck yes all_in yes particles_in_region 200 region fill
+            fix integrate all nve/sphere
+        """)
+        lg.add_pair_contacts()
+        ev = ContactEvents(lg)
+        lg.run(1)
+        ev.take()
+        key = lambda i, j: (int(min(i, j)), int(max(i, j)))
+        c = lg.pair_contacts()
+        before = {key(i, j) for i, j in zip(c.i, c.j)}
+        begun = ended = 0
+        for _ in range(6000):
+            lg.run(1)
+            c = lg.pair_contacts()
+            now = {key(i, j) for i, j in zip(c.i, c.j)}
+            got = ev.take()
+            pairs = got[~got["wall"]]
+            assert {key(e["i"], e["j"]) for e in pairs[pairs["kind"] == BEGIN]} == now - before
+            assert {key(e["i"], e["j"]) for e in pairs[pairs["kind"] == END]} == before - now
+            begun += len(now - before)
+            ended += len(before - now)
+            before = now
+        print(f"{begun} pair contacts begun, {ended} ended, {len(now)} open at the end")
+        assert begun > 200 and ended > 100
+
+
+def test_events_catch_a_collision_shorter_than_the_sampling_interval(tmp_path):
+    """Two fast stiff spheres whose contact lasts 3 steps: sampling LIGGGHTS' contact list
+    every 5 steps misses it; the events record its begin and end."""
+    V = 2.0
+    t_c = hertz_contact_time(2 * V)
+    dt = t_c / 3.2                              # about 3 steps in contact
+    with box(tmp_path, dt=dt) as lg:
+        lg.commands(f"""
+            create_atoms 1 single {-1.5 * R} 0 0 units box
+            create_atoms 1 single {1.5 * R} 0 0 units box
+            set atom 1 diameter {2 * R} density {RHO} vx {V}
+            set atom 2 diameter {2 * R} density {RHO} vx {-V}
+            fix integrate all nve/sphere
+        """)
+        lg.add_pair_contacts()
+        ev = ContactEvents(lg)
+        lg.run(0)
+        start = math.floor(R / (2 * V) / dt) + 1        # first step in contact
+        lg.run(start - 1 - (start - 1) % 5 + 5 if (start - 1) % 5 else start - 1)
+        samples = []
+        while lg.step < start + 20:
+            lg.run(5)
+            samples.append(len(lg.pair_contacts()))
+        got = ev.take()
+    begin, end = got[got["kind"] == BEGIN], got[got["kind"] == END]
+    print(f"samples every 5 steps saw {sum(samples)} contacts; events: {len(begin)} begin, "
+          f"duration {end['duration'].tolist()} steps")
+    assert sum(samples) == 0
+    assert len(begin) == 1 and len(end) == 1 and 1 <= end[0]["duration"] <= 5
+    assert begin[0]["vn"] == pytest.approx(2 * V, rel=1e-12)
