@@ -36,12 +36,17 @@ from pyhost.contact_heat import evaluate_flagged, restitution_impulse, side_heat
 from pyhost.dem_input import script_dem_contacts
 from pyhost import checkpoint, signals
 from pyhost.engines.dem import Dem
+from pyhost.engines.events import BEGIN
 from pyhost.failures import particles_lost
 from pyhost.engines.liggghts import LiggghtsError
 from pyhost.outdir import write_atomic
 from pyhost.output import ColumnLog, CsvLog, Progress, VtkSeries, collision_kinds
 from pyhost.script import ScriptError, parse_run
 
+HARVEST_EVERY = 1000
+"""DEM steps between harvests of the contact events at most (they are also taken at every
+frame, fluid exchange, checkpoint and sample): bounds the recorder's buffer and the wait of a
+signal (a stop is taken between two DEM chunks)."""
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 OPEN_COLUMNS = ("start", "t_coll", "e", "v0", "nx", "ny", "nz")
 """What the host keeps of each open contact: start time [s], model duration [s], the model's
@@ -133,7 +138,10 @@ class Coupling:
         self.frames = VtkSeries(self.out / "vtk", "particles", logs.get("particles")) if scene.output.vtk else None
         self.fluid_frames = VtkSeries(self.out / "vtk", "fluid") if fluid is not None and scene.output.vtk else None
         self.progress = Progress(end or math.inf, progress_every)
-        self.every = dict(sample=scene.time.sample_every if self.effects["contact_extraction"] else 0,
+        self.events = dem.events is not None     # contacts recorded inside LIGGGHTS (else sampled)
+        sampled = self.effects["contact_extraction"] and (not self.events or dem.sampled_walls())
+        self.every = dict(sample=scene.time.sample_every if sampled else 0,
+                          harvest=HARVEST_EVERY if self.events else 0,
                           frame=max(1, round(scene.output.every / dem.dt)),
                           couple=scene.time.couple_every if fluid is not None else 0,
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
@@ -147,6 +155,8 @@ class Coupling:
         self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
         self.T_wall = np.array([w.temperature if self.effects["wall_heat"] else np.nan for w in walls])
         self.wall_material = np.array([w.material for w in walls], int)
+        if self.dem.events is not None:
+            self.dem.event_planes(self.wall_index)
 
     def start(self) -> None:
         """The first fluid exchange and the first frame (after construction, so that an
@@ -186,10 +196,13 @@ class Coupling:
             step += chunk
             self.t = self.dem.step * self.dem.dt
             due = {name: k and step % k == 0 for name, k in self.every.items()}
-            if due["sample"]:
+            if due["sample"] or (self.events and any(due.values())):
                 atoms = self.dem.atoms(self.heat)
                 self.track_particles(atoms)
-                self.sample_contacts(atoms)
+                if self.events:
+                    self.harvest(atoms)
+                if due["sample"]:
+                    self.sample_contacts(atoms)
                 if self.keep_all is not None:
                     self.note_before(atoms)         # spares a gather of all atoms under MPI
             if due["couple"]:
@@ -200,8 +213,11 @@ class Coupling:
                 checkpoint.write(self)
             self.progress.update(self.t, f", {self.totals['collisions']} collisions")
             signals.check()
-        if self.heat:
-            self.track_particles(self.dem.atoms(True))
+        if self.heat or self.events:
+            atoms = self.dem.atoms(self.heat)
+            self.track_particles(atoms)
+            if self.events:
+                self.harvest(atoms)
 
     def note_before(self, atoms) -> None:
         """The particles before the next chunk (time, ids, positions, velocities, step): what
@@ -414,10 +430,31 @@ class Coupling:
         return (wall, jl, mat, typ, np.where(wall, np.inf, atoms.radius[jj]),
                 np.where(wall, np.inf, atoms.mass[jj]))
 
+    def harvest(self, atoms) -> None:
+        """The contact events recorded inside LIGGGHTS since the last harvest: each begun
+        contact is a collision, at its impact speed as recorded at first touch, its heat moved
+        now in the order the collisions happened. Nothing else changes a temperature between
+        two harvests (they come at every fluid exchange, frame and sample), so the heat is what
+        it would be if moved at each collision's own step. A collision whose particle left the
+        simulation before the harvest (deleted, out of the box) is counted apart
+        (collisions_of_departed) and moves no heat: its heat content left at its last sample."""
+        ev = self.dem.events.take()
+        begin = ev[ev["kind"] == BEGIN]
+        if not len(begin):
+            return
+        i = atoms.index(begin["i"])
+        j_here = np.where(begin["wall"], 0, atoms.index(np.where(begin["wall"], begin["i"], begin["j"])))
+        here = (i >= 0) & (j_here >= 0)
+        if not here.all():
+            self.totals["collisions_of_departed"] = self.totals.get("collisions_of_departed", 0) + int((~here).sum())
+            begin = begin[here]
+        if len(begin):
+            self.collide(atoms, begin["i"], begin["j"], np.abs(begin["vn"]), begin["n"], begin["step"] * self.dem.dt)
+
     def start_collisions(self, atoms, c, keys, rows) -> None:
         i = atoms.index(c.i[rows])
         wall, jl, mj, tj, R_j, m_j = self.partners(atoms, i, c.j[rows])
-        mi, ti, R_i, m_i = self.materials_of(atoms.type[i]), atoms.type[i], atoms.radius[i], atoms.mass[i]
+        ti, R_i, m_i = atoms.type[i], atoms.radius[i], atoms.mass[i]
         R_eff = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
         m_eff = np.where(wall, m_i, m_i * m_j / np.where(wall, 1.0, m_i + m_j))
         delta, approach = c.delta[rows], c.approach[rows]
@@ -431,6 +468,18 @@ class Coupling:
             self.warned.add("model")
             print(f"warning: the DEM's normal model is '{self.dem.info.pair_model}', not hertz: impact speeds "
                   "are the approach speeds at the first sample in contact, not integrated back to touch")
+        at = self.collide(atoms, c.i[rows], c.j[rows], v0, c.normal[rows], np.full(len(rows), self.t))
+        self.info[rows] = at
+
+    def collide(self, atoms, ids_i, j, v0, normal, time) -> np.ndarray:
+        """Collisions of particles ``ids_i`` with partners ``j`` (ids, or WALL_BASE + wall) at
+        impact speeds v0 [m/s] with unit normals (j to i), begun at ``time`` [s]: the plugin's
+        heat moved in this order, the totals and the collision log. Returns their OPEN_COLUMNS
+        rows."""
+        i = atoms.index(ids_i)
+        wall, jl, mj, _, R_j, _ = self.partners(atoms, i, j)
+        mi, R_i = self.materials_of(atoms.type[i]), atoms.radius[i]
+        rows = np.arange(len(i))
         models = self.scene.effects.heat_models
         model = models[0] if models else "none"
         moved = e = t_coll = np.zeros(len(rows))
@@ -450,14 +499,13 @@ class Coupling:
             by_model = self.heat_by_model()
             for m, q in zip(models, [moved] + list(side.values())):
                 by_model[m] += float(np.abs(q[~wall]).sum())
-        self.info[rows] = np.column_stack([np.full(len(rows), self.t), t_coll, e, v0, c.normal[rows]])
         self.totals["collisions"] += len(rows)
         self.totals["particle_wall"] += int(wall.sum())
         self.totals["particle_particle"] += int((~wall).sum())
-        self.collisions.write_columns(time=np.full(len(rows), self.t), i=c.i[rows],
-                                      j=np.where(wall, 0, c.j[rows]),
-                                      wall=np.where(wall, c.j[rows] - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
+        self.collisions.write_columns(time=time, i=ids_i, j=np.where(wall, 0, j),
+                                      wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
                                       t_coll=t_coll, model=np.full(len(rows), model), **side)
+        return np.column_stack([time, t_coll, e, v0, normal])
 
     def heat_by_model(self) -> dict:
         """Heat between particles [J], sum of |Q| over collisions, of each heat model: the one
@@ -593,7 +641,20 @@ class Coupling:
             p, u = self.fluid.fields()
             self.fluid_frames.write(self.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)
 
+    def flush_events(self) -> None:
+        """The contact events recorded since the last harvest, taken now (a run stopped
+        between harvests: its checkpoint and summary hold every collision)."""
+        if self.events and self.ready and self.dem.events.waiting:
+            atoms = self.dem.atoms(self.heat)
+            self.track_particles(atoms)
+            self.harvest(atoms)
+
     def finish(self, status: str = "completed") -> dict:
+        if status != "completed":
+            try:
+                self.flush_events()
+            except Exception as err:          # the error that stopped the run is the one to report
+                print(f"warning: the collisions since the last harvest are not in the log ({type(err).__name__}: {err})")
         for series in (self.frames, self.fluid_frames):
             if series is not None:
                 series.flush()
@@ -657,7 +718,9 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             if coupling is None:
                 try:
                     added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
-                                        fluid_force=fluid is not None)
+                                        fluid_force=fluid is not None,
+                                        events=scene.time.contacts == "events"
+                                        and dem.events_possible(scene.effects.restitution_feedback))
                 except LiggghtsError as exc:
                     raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
                 log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
@@ -691,6 +754,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
                 and coupling.every["checkpoint"]:
             try:
+                coupling.flush_events()
                 checkpoint.write(coupling)
             except Exception as err:      # the stop goes on: summary, engines closed, exit 128 + n
                 log(f"warning: no checkpoint at the stop ({type(err).__name__}: {err}); the last one stays")

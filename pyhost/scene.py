@@ -228,7 +228,13 @@ class Time:
     end: float = spec(">=0", 0.0, "simulated time [s] (box scenes; a script's runs set it, except a CFD-DEM "
                                   "script's final 'run 0', which the coupling drives for this long, else for "
                                   "the fluid case's controlDict endTime)")
-    sample_every: int = spec(">0", 1, "DEM steps between contact samples")
+    contacts: str = spec("in:events,samples", "events",
+                         "how collisions are found: 'events', recorded inside LIGGGHTS at every step (the "
+                         "impact speed as it is at first touch, no collision missed; serial runs without "
+                         "restitution feedback or fix heat/gran, else samples are used), or 'samples' of "
+                         "LIGGGHTS' contact lists every sample_every steps")
+    sample_every: int = spec(">0", 1, "DEM steps between contact samples (with events: between samples of "
+                                      "the walls LIGGGHTS lists only, mesh and cylinder walls)")
     couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Run public tutorials nobody here wrote through the host, as a user would, and check
 their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI and packedBedTemp, and
-Debian's liggghts-doc tutorials (packing, heatTransfer_1, chute_wear).
+Debian's liggghts-doc tutorials (packing, heatTransfer_1, chute_wear, conveyor).
 
 The tutorials are not part of this repository (their licences are theirs, and fetched
 content is never committed): point ``--cfdem`` at a CFDEMcoupling-PUBLIC checkout; Debian's
@@ -248,6 +248,7 @@ TUTORIALS = [
              checks=liggghts_checks),
     Tutorial("chute_wear", "liggghts", "chute_wear", ".", liggghts_scene("in.chute_wear", 2500.0),
              checks=liggghts_checks),
+    Tutorial("conveyor", "liggghts", "conveyor", ".", liggghts_scene("in.conveyor", 2500.0), checks=liggghts_checks),
 ]
 
 

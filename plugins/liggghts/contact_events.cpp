@@ -46,6 +46,7 @@ struct Recorder {
     std::vector<int> axis;                     // primitive planes: axis (0, 1, 2), position [m],
     std::vector<double> position;              // and the partner code the host gives them
     std::vector<double> code;
+    bool new_planes = false;                   // planes given since the last call: what touches them is open
     long long begun = 0, ended = 0;
 
     // The state of the contacts, laid out like the neighbour list (one slot per entry, in
@@ -70,7 +71,7 @@ struct Recorder {
 
     // Slot k in contact now (its key k_, ids i and j, approach speed vn, normal n).
     inline void on(size_t k, bigint step, bool rebuilt, int kind, uint64_t k_, double i, double j, double vn,
-                   const double *n)
+                   const double *n, bool quiet = false)
     {
         if (touch[k] && !rebuilt) return;
         touch[k] = 1;
@@ -80,7 +81,7 @@ struct Recorder {
             if (it != carry.end()) { since[k] = it->second; carry.erase(it); return; }
         }
         since[k] = step;
-        if (primed) { event(kind, step, i, j, vn, n, 0.0); ++begun; }
+        if (primed && !quiet) { event(kind, step, i, j, vn, n, 0.0); ++begun; }
     }
 
     // Slot k not in contact now: an END if it was (between builds; at a build, what is left
@@ -170,7 +171,7 @@ struct Recorder {
                 double n[3] = {0, 0, 0};
                 n[a] = gap >= 0 ? 1.0 : -1.0;                                  // from the wall to the particle
                 on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(code[w]), tag[i], code[w],
-                   -v[i][a] * n[a], n);
+                   -v[i][a] * n[a], n, new_planes);
             }
         }
         if (rebuilt) {                         // contacts of the old layout not found again: ended
@@ -178,6 +179,7 @@ struct Recorder {
             carry.clear();
         }
         primed = true;
+        new_planes = false;
     }
 
     long long open_count() const
@@ -217,13 +219,18 @@ void *collheat_events_attach(void *ptr, const char *fix_id)
 }
 
 // The host's primitive planes: n of them, each an axis (0, 1, 2), a position [m] and the
-// partner code of its contacts (WALL_BASE + the host's wall index).
+// partner code of its contacts (WALL_BASE + the host's wall index). Particles touching a
+// plane when it is given are in contact, not colliding (as those touching anything at the start).
 void collheat_events_planes(void *handle, int n, const int *axis, const double *position, const double *code)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
+    if (std::vector<int>(axis, axis + n) == rec->axis && std::vector<double>(position, position + n) == rec->position &&
+        std::vector<double>(code, code + n) == rec->code)
+        return;                                // the same planes again (at each run of a script)
     rec->axis.assign(axis, axis + n);
     rec->position.assign(position, position + n);
     rec->code.assign(code, code + n);
+    rec->new_planes = true;
 }
 
 // The next call records the contacts present as open, with no BEGIN events (a start or restart).

@@ -93,6 +93,7 @@ class Dem:
         self.log = log
         self.pair_cols = self.wall_cols = None
         self._warned_mesh = False
+        self.events = None        # the contact event recorder (pyhost.engines.events), if asked for
         self._warnings = set()    # LIGGGHTS warnings already shown
         self._pending = None      # under MPI: the last gathered atoms, their T and v as gathered
         self._counts = None       # under MPI: atoms per rank in the last gather
@@ -113,6 +114,8 @@ class Dem:
     def close(self) -> None:
         if self.link is not None:
             self.link.close()
+        if self.events is not None:
+            self.events.close()
         self.lmp.close()
 
     # -- the script -----------------------------------------------------------------
@@ -179,16 +182,30 @@ class Dem:
             raise ScriptError(f"run {steps}{' upto' if upto else ''}: {why} (LIGGGHTS: 'Invalid run command')")
         return n
 
-    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False) -> list[str]:
+    def events_possible(self, restitution_feedback: bool) -> bool:
+        """Whether the contact events can stand for samples of the pair contacts: serial (each
+        rank's own events are the issue on MPI), no fix heat/gran (its conduction during a
+        collision is taken back from sampled fluxes) and no restitution feedback (imposed at
+        the sample that sees a contact end)."""
+        return self.link is None and not self.info.heat_gran and not restitution_feedback
+
+    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
+                events: bool = False) -> list[str]:
         """What the host adds before the first run: the Temp property (if no fix heat/gran or
-        property/atom Temp made it), the contact computes the script lacks, and the fluid force.
+        property/atom Temp made it), the contact computes the script lacks (with ``events``, the
+        contact event recorder in place of the pair compute), and the fluid force.
         ``contacts``: whether the loop samples contacts (default: with heat). Returns the
         added commands (printed once)."""
+        from pyhost.engines.events import FIX as EVENTS_FIX
+
         contacts = heat if contacts is None else contacts
+        events = events and contacts
         added = []
         if heat and not self.info.temp_fix and not self.info.heat_gran:
             added.append("fix Temp all property/atom Temp scalar yes yes no 0.0")
-        if contacts and self.info.pair_compute is None:
+        if events:
+            added.append(f"fix {EVENTS_FIX} all external pf/callback 1 1")
+        if contacts and not events and self.info.pair_compute is None:
             keys = "pos vel id delta" + (" heatFlux" if self.info.heat_gran else "")
             added.append(f"compute {PAIR_COMPUTE} all pair/gran/local {keys}")
         if contacts and self.info.wall_compute is None and any(w.meshes for w in self.info.walls.values()):
@@ -197,6 +214,9 @@ class Dem:
             added.append(f"fix {FLUID_FIX} all external pf/array 1")
         for line in added:
             self.command(Command(line, "(host)", 0))
+        if events:
+            from pyhost.engines.events import ContactEvents
+            self.events = ContactEvents(self.lmp)
         for which in ("pair_compute", "wall_compute"):
             found = getattr(self.info, which)
             if found and found[0] not in (PAIR_COMPUTE, WALL_COMPUTE):
@@ -337,12 +357,28 @@ class Dem:
         return self.info.pair_compute is not None and "heatFlux" in self.info.pair_compute[1]
 
     # -- contacts ---------------------------------------------------------------------
+    def sampled_walls(self) -> bool:
+        """Whether some wall's contacts must still be sampled with the event recorder (mesh
+        walls, cylinders: it records pairs and planes)."""
+        return any(w.meshes or (w.primitive is not None and not w.primitive[0].endswith("plane"))
+                   for w in self.info.walls.values())
+
+    def event_planes(self, wall_index: dict) -> None:
+        """The primitive plane walls, for the event recorder, with their contact codes."""
+        planes = [("xyz".index(w.primitive[0][0]), w.primitive[1][0], WALL_BASE + wall_index[fix, 0])
+                  for fix, w in self.info.walls.items() if w.primitive is not None and w.primitive[0].endswith("plane")]
+        self.events.planes(*(zip(*planes) if planes else ([], [], [])))
+
     def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:
-        """Every contact now (see :class:`Contacts`). ``wall_index``: host wall index of each
+        """Every contact now (see :class:`Contacts`); with the event recorder, only those it
+        does not record: mesh and cylinder walls. ``wall_index``: host wall index of each
         (wall/gran fix id, mesh index in the fix); a particle touching several triangles of one
         mesh is one contact (the deepest)."""
-        parts = [self._pair_contacts(atoms)]
+        events = self.events is not None
+        parts = [] if events else [self._pair_contacts(atoms)]
         for fix, wall in self.info.walls.items():
+            if events and wall.primitive is not None and wall.primitive[0].endswith("plane"):
+                continue
             if wall.primitive is not None:
                 parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix, 0]))
         mesh_fixes = [f for f, w in self.info.walls.items() if w.meshes]

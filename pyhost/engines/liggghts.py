@@ -246,12 +246,13 @@ class Liggghts:
 
     def run(self, steps: int) -> None:
         """Advance ``steps`` time steps as one chunk (``run N pre no post no``); the first run
-        after any command does a full set-up (``pre yes``) and is tried first."""
+        after any command does a full set-up (``pre yes``), tried first in a forked copy (an
+        error there is bad input, LiggghtsError); an error while stepping is LiggghtsFailed."""
         if steps < 0:
             raise ValueError(f"steps must be >= 0, got {steps}")
         line = f"run {steps} post no" if self._changed else f"run {steps} pre no post no"
-        if self._changed:
-            self._tried(lambda: self._call(line), line)
+        if self._changed:       # the set-up is tried (bad input); what fails while stepping returns
+            self._tried(lambda: self._call("run 0 post no"), line)
         self._execute(line, LiggghtsFailed, what="during the run, at step {step}")
         self._changed = False
 
