@@ -437,7 +437,8 @@ class Coupling:
         two harvests (they come at every fluid exchange, frame and sample), so the heat is what
         it would be if moved at each collision's own step. A collision whose particle left the
         simulation before the harvest (deleted, out of the box) is counted apart
-        (collisions_of_departed) and moves no heat: its heat content left at its last sample."""
+        (collisions_of_departed) and moves no heat: its heat content left at its last sample;
+        so is one that began with no approach speed (contacts_without_impact)."""
         ev = self.dem.events.take()
         begin = ev[ev["kind"] == BEGIN]
         if not len(begin):
@@ -447,9 +448,14 @@ class Coupling:
         here = (i >= 0) & (j_here >= 0)
         if not here.all():
             self.totals["collisions_of_departed"] = self.totals.get("collisions_of_departed", 0) + int((~here).sum())
-            begin = begin[here]
+        # a contact that begins without closing in (particles grown into each other by a fix
+        # adapt, or placed touching) is no impact: open, with no collision heat
+        still = here & ~(begin["vn"] > 0)
+        if still.any():
+            self.totals["contacts_without_impact"] = self.totals.get("contacts_without_impact", 0) + int(still.sum())
+        begin = begin[here & ~still]
         if len(begin):
-            self.collide(atoms, begin["i"], begin["j"], np.abs(begin["vn"]), begin["n"], begin["step"] * self.dem.dt)
+            self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["n"], begin["step"] * self.dem.dt)
 
     def start_collisions(self, atoms, c, keys, rows) -> None:
         i = atoms.index(c.i[rows])

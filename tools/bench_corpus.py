@@ -5,7 +5,7 @@ default outputs (``python -m pyhost run``), one after the other in one process, 
 ratio of their wall times. The host's time includes its start-up (Python, the plugin's tables,
 LIGGGHTS set-up: about 2 s).
 
-    .venv/bin/python tools/bench_corpus.py [--only packing conveyor]
+    .venv/bin/python tools/bench_corpus.py [--only packing conveyor] [--contacts samples]
 
 Debian's tutorials: packing, heatTransfer_1, chute_wear, conveyor (liggghts-doc). The machine is shared:
 compare the ratios, measured in one run, with nothing else running.
@@ -39,6 +39,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--only", nargs="+", choices=list(SCRIPTS))
     ap.add_argument("--work", type=Path, default=Path("/tmp/collheat-bench-corpus"))
+    ap.add_argument("--contacts", choices=("events", "samples"), default="events",
+                    help="[time] contacts of the host's runs (samples: as before contact events)")
     args = ap.parse_args(argv)
     args.work.mkdir(parents=True, exist_ok=True)
     inputs = []
@@ -49,6 +51,8 @@ def main(argv=None) -> int:
     rows = []
     for tut, script in inputs:
         copy = corpus.prepare(tut, None, args.work)
+        toml = copy / tut.case_dir / "case.toml"
+        toml.write_text(toml.read_text() + f'\n[time]\ncontacts = "{args.contacts}"\n')
         native_copy = args.work / (tut.name + "-native")
         shutil.rmtree(native_copy, ignore_errors=True)
         shutil.copytree(copy, native_copy)
