@@ -30,6 +30,9 @@
 #include "fix_external.h"
 #include "update.h"
 #include "neighbor.h"
+#include "fix_mesh_surface.h"
+#include "fix_neighlist_mesh.h"
+#include "tri_mesh.h"
 
 using namespace LAMMPS_NS;
 
@@ -46,6 +49,9 @@ struct Recorder {
     std::vector<int> axis;                     // primitive planes: axis (0, 1, 2), position [m],
     std::vector<double> position;              // and the partner code the host gives them
     std::vector<double> code;
+    std::vector<FixMeshSurface *> meshes;       // mesh walls: the fix mesh/surface and the code
+    std::vector<double> mesh_code;             // of its contacts (one per particle and mesh: the deepest)
+    std::vector<double> depth, normal;         // per mesh and local atom, this call: overlap [m] and normal
     bool new_planes = false;                   // planes given since the last call: what touches them is open
     long long begun = 0, ended = 0;
 
@@ -114,13 +120,14 @@ struct Recorder {
         NeighList *list = pair ? pair->list : nullptr;
         const bool have_list = list && list->ilist;
         // a new layout at each neighbour build (or new planes): the slots counted then only
-        const bool rebuilt = lmp->neighbor->ncalls != layout || axis.size() != planes_laid || nlocal != nlocal_laid;
+        const size_t walls = axis.size() + meshes.size();
+        const bool rebuilt = lmp->neighbor->ncalls != layout || walls != planes_laid || nlocal != nlocal_laid;
         if (rebuilt) {                         // the open contacts, by key, into the new layout
             size_t slots = 0;
             if (have_list)
                 for (int ii = 0; ii < list->inum; ++ii) slots += list->numneigh[list->ilist[ii]];
-            slots += axis.size() * size_t(nlocal);
-            planes_laid = axis.size();
+            slots += walls * size_t(nlocal);
+            planes_laid = walls;
             nlocal_laid = nlocal;
             carry.clear();
             for (size_t k = 0; k < touch.size(); ++k)
@@ -172,6 +179,47 @@ struct Recorder {
                 n[a] = gap >= 0 ? 1.0 : -1.0;                                  // from the wall to the particle
                 on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(code[w]), tag[i], code[w],
                    -v[i][a] * n[a], n, new_planes);
+            }
+        }
+        // mesh walls: LIGGGHTS' own candidates of each triangle and its own contact test
+        // (TriMesh::resolveTriSphereContact: distance - radius < 0), the deepest triangle
+        // giving the normal, turned to point from the wall to the particle
+        if (!meshes.empty()) {
+            depth.assign(meshes.size() * size_t(nlocal), 0.0);
+            normal.resize(3 * meshes.size() * size_t(nlocal));
+        }
+        for (size_t m = 0; m < meshes.size(); ++m) {
+            TriMesh *mesh = meshes[m]->triMesh();
+            FixNeighlistMesh *near = meshes[m]->meshNeighlist();
+            if (!near) continue;
+            const int ntri = mesh->sizeLocal() + mesh->sizeGhost();
+            for (int t = 0; t < ntri; ++t) {
+                const std::vector<int> &cand = near->get_contact_list(t);
+                for (int p : cand) {
+                    if (p >= nlocal) continue;
+                    double delta[3];
+                    int barysign;
+                    const double dn = mesh->resolveTriSphereContact(p, t, r[p], x[p], delta, barysign);
+                    double &best = depth[m * nlocal + p];
+                    if (dn >= 0 || dn >= best) continue;
+                    best = dn;
+                    double node0[3];
+                    mesh->node(t, 0, node0);
+                    const double len = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
+                    double s = len > 0 ? 1.0 / len : 0.0;
+                    if ((x[p][0] - node0[0]) * delta[0] + (x[p][1] - node0[1]) * delta[1] + (x[p][2] - node0[2]) * delta[2] < 0)
+                        s = -s;
+                    double *n = &normal[3 * (m * nlocal + p)];
+                    n[0] = delta[0] * s; n[1] = delta[1] * s; n[2] = delta[2] * s;
+                }
+            }
+            for (int i = 0; i < nlocal; ++i, ++k) {
+                if (depth[m * nlocal + i] >= 0) { off(k, step, rebuilt); continue; }
+                if (touch[k] && !rebuilt) continue;
+                const double *n = &normal[3 * (m * nlocal + i)];
+                const double vn = -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]);   // the wall's own motion left out
+                on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]), tag[i], mesh_code[m],
+                   vn, n, new_planes);
             }
         }
         if (rebuilt) {                         // contacts of the old layout not found again: ended
@@ -231,6 +279,26 @@ void collheat_events_planes(void *handle, int n, const int *axis, const double *
     rec->position.assign(position, position + n);
     rec->code.assign(code, code + n);
     rec->new_planes = true;
+}
+
+// The host's mesh walls: n `fix mesh/surface` ids and the partner code of each. Returns the
+// number found with a neighbour list (a mesh used by a fix wall/gran), or -1 if one is not.
+int collheat_events_meshes(void *handle, int n, const char **ids, const double *code)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    std::vector<FixMeshSurface *> found;
+    for (int k = 0; k < n; ++k) {
+        const int f = rec->lmp->modify->find_fix(ids[k]);
+        if (f < 0 || std::strncmp(rec->lmp->modify->fix[f]->style, "mesh/surface", 12) != 0) return -1;
+        FixMeshSurface *mesh = static_cast<FixMeshSurface *>(rec->lmp->modify->fix[f]);
+        if (!mesh->meshNeighlist()) return -1;
+        found.push_back(mesh);
+    }
+    if (found == rec->meshes && std::vector<double>(code, code + n) == rec->mesh_code) return n;
+    rec->meshes = found;
+    rec->mesh_code.assign(code, code + n);
+    rec->new_planes = true;
+    return n;
 }
 
 // The next call records the contacts present as open, with no BEGIN events (a start or restart).

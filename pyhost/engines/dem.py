@@ -94,6 +94,8 @@ class Dem:
         self.pair_cols = self.wall_cols = None
         self._warned_mesh = False
         self.events = None        # the contact event recorder (pyhost.engines.events), if asked for
+        self._mesh_events = False  # the recorder takes the mesh walls too
+        self._warned_mesh_events = False
         self._warnings = set()    # LIGGGHTS warnings already shown
         self._pending = None      # under MPI: the last gathered atoms, their T and v as gathered
         self._counts = None       # under MPI: atoms per rank in the last gather
@@ -358,16 +360,22 @@ class Dem:
 
     # -- contacts ---------------------------------------------------------------------
     def sampled_walls(self) -> bool:
-        """Whether some wall's contacts must still be sampled with the event recorder (mesh
-        walls, cylinders: it records pairs and planes)."""
-        return any(w.meshes or (w.primitive is not None and not w.primitive[0].endswith("plane"))
+        """Whether some wall's contacts must still be sampled beside the event recorder
+        (cylinders; mesh walls it could not take)."""
+        return any((w.meshes and not self._mesh_events) or (w.primitive is not None and not w.primitive[0].endswith("plane"))
                    for w in self.info.walls.values())
 
     def event_planes(self, wall_index: dict) -> None:
-        """The primitive plane walls, for the event recorder, with their contact codes."""
+        """The primitive plane and mesh walls, for the event recorder, with their contact codes."""
         planes = [("xyz".index(w.primitive[0][0]), w.primitive[1][0], WALL_BASE + wall_index[fix, 0])
                   for fix, w in self.info.walls.items() if w.primitive is not None and w.primitive[0].endswith("plane")]
         self.events.planes(*(zip(*planes) if planes else ([], [], [])))
+        meshes = [(mesh, WALL_BASE + wall_index[fix, k]) for fix, w in self.info.walls.items()
+                  for k, mesh in enumerate(w.meshes or ())]
+        self._mesh_events = self.events.meshes(*(zip(*meshes) if meshes else ([], [])))
+        if not self._mesh_events and not self._warned_mesh_events:
+            self._warned_mesh_events = True
+            self.log("note: a mesh wall has no neighbour list the event recorder can use: its contacts are sampled")
 
     def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:
         """Every contact now (see :class:`Contacts`); with the event recorder, only those it
@@ -381,7 +389,7 @@ class Dem:
                 continue
             if wall.primitive is not None:
                 parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix, 0]))
-        mesh_fixes = [f for f, w in self.info.walls.items() if w.meshes]
+        mesh_fixes = [f for f, w in self.info.walls.items() if w.meshes and not (events and self._mesh_events)]
         if mesh_fixes and self.info.wall_compute is None:
             if not self._warned_mesh:
                 self._warned_mesh = True

@@ -26,6 +26,7 @@ _vp, _int, _dp = _c.c_void_p, _c.c_int, _c.POINTER(_c.c_double)
 _DECLARATIONS = {
     "collheat_events_attach": (_vp, [_vp, _c.c_char_p]),
     "collheat_events_planes": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp]),
+    "collheat_events_meshes": (_int, [_vp, _int, _c.POINTER(_c.c_char_p), _dp]),
     "collheat_events_prime": (None, [_vp]),
     "collheat_events_waiting": (_int, [_vp]),
     "collheat_events_open": (_int, [_vp]),
@@ -59,6 +60,13 @@ class ContactEvents:
         codes = np.ascontiguousarray(codes, dtype=float)
         self.lmp.helper.collheat_events_planes(self.handle, len(axes), axes.ctypes.data_as(_c.POINTER(_int)),
                                                positions.ctypes.data_as(_dp), codes.ctypes.data_as(_dp))
+
+    def meshes(self, ids, codes) -> bool:
+        """Mesh walls: the ``fix mesh/surface`` id and the partner code of each. False (and
+        none recorded) if one has no neighbour list of a fix wall/gran to take candidates from."""
+        arr = (_c.c_char_p * len(ids))(*[i.encode() for i in ids])
+        codes = np.ascontiguousarray(codes, dtype=float)
+        return self.lmp.helper.collheat_events_meshes(self.handle, len(ids), arr, codes.ctypes.data_as(_dp)) >= 0
 
     def prime(self) -> None:
         """The next step records the contacts there as open, without events (a (re)start)."""

@@ -147,3 +147,70 @@ def test_events_catch_a_collision_shorter_than_the_sampling_interval(tmp_path):
     assert sum(samples) == 0
     assert len(begin) == 1 and len(end) == 1 and 1 <= end[0]["duration"] <= 5
     assert begin[0]["vn"] == pytest.approx(2 * V, rel=1e-12)
+
+
+FLOOR = """solid floor
+facet normal 0 0 1
+outer loop
+vertex -0.02 -0.02 -0.01
+vertex 0.02 -0.02 -0.01
+vertex 0.02 0.02 -0.01
+endloop
+endfacet
+facet normal 0 0 1
+outer loop
+vertex -0.02 -0.02 -0.01
+vertex 0.02 0.02 -0.01
+vertex -0.02 0.02 -0.01
+endloop
+endfacet
+endsolid floor
+"""
+
+
+def test_mesh_wall_events_follow_liggghts_own_wall_contact_list(tmp_path):
+    """Spheres poured onto an STL floor (two triangles): a sphere meets it at the free-fall
+    speed, and at every step the particles that begin and end touching the mesh are exactly
+    those compute wall/gran/local gains and loses (a particle on both triangles is one contact)."""
+    (tmp_path / "floor.stl").write_text(FLOOR)
+    with box(tmp_path, dt=1e-5) as lg:
+        lg.commands(f"""
+            fix gravi all gravity 9.81 vector 0 0 -1
+            fix cad all mesh/surface file {tmp_path / 'floor.stl'} type 1
+            fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad
+            region fill block -0.008 0.008 -0.008 0.008 -0.006 0.009 units box
+            fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
+            fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+            fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 0 insert_every once overlapcheck yes all_in yes particles_in_region 60 region fill
+            fix integrate all nve/sphere
+        """)
+        lg.add_wall_contacts()
+        ev = ContactEvents(lg)
+        lg.run(1)
+        assert ev.meshes(["cad"], [WALL_BASE + 3])
+        lg.run(1)
+        ev.take()
+        z0 = {int(i): z for i, z in zip(lg.atom("id"), lg.atom("x")[:, 2])}
+        # compute wall/gran/local 'vel id contactArea delta': ids are columns 6-8 (mesh, triangle,
+        # atom: LIGGGHTS' order, ENGINES.md); a particle on both triangles is listed twice
+        touching = lambda: set(lg.local_array("walls")[:, 8].astype(int).tolist())
+        before = touching()
+        begun = 0
+        first = None
+        for _ in range(4000):
+            lg.run(1)
+            now = touching()
+            got = ev.take()
+            walls = got[got["wall"]]
+            assert set(walls["j"].tolist()) <= {WALL_BASE + 3}
+            assert set(walls[walls["kind"] == BEGIN]["i"].tolist()) == now - before
+            assert set(walls[walls["kind"] == END]["i"].tolist()) == before - now
+            if first is None and len(walls[walls["kind"] == BEGIN]):
+                first = walls[walls["kind"] == BEGIN][0]
+            begun += len(now - before)
+            before = now
+    h = z0[int(first["i"])] - (-0.01 + R)             # its fall from rest to touch
+    print(f"{begun} mesh contacts begun; first at vn {first['vn']:.5f} m/s, sqrt(2 g h) {math.sqrt(2 * 9.81 * h):.5f}")
+    assert begun >= 10
+    assert first["vn"] == pytest.approx(math.sqrt(2 * 9.81 * h), rel=1e-2)
+    assert np.allclose(first["n"], [0, 0, 1], atol=1e-9)
