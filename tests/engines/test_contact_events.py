@@ -30,16 +30,21 @@ def box(tmp_path, lo=(-0.01,) * 3, hi=(0.01,) * 3, dt=DT) -> Liggghts:
     return lg
 
 
+def head_on(lg, V):
+    """Two spheres 3R apart on the x axis, closing in at V each [m/s]."""
+    lg.commands(f"""
+        create_atoms 1 single {-1.5 * R} 0 0 units box
+        create_atoms 1 single {1.5 * R} 0 0 units box
+        set atom 1 diameter {2 * R} density {RHO} vx {V}
+        set atom 2 diameter {2 * R} density {RHO} vx {-V}
+        fix integrate all nve/sphere
+    """)
+
+
 def test_a_head_on_pair_gives_one_begin_at_its_impact_speed_and_one_end_after_the_hertz_time(tmp_path):
     V = 1.0                                     # m/s each
     with box(tmp_path) as lg:
-        lg.commands(f"""
-            create_atoms 1 single {-1.5 * R} 0 0 units box
-            create_atoms 1 single {1.5 * R} 0 0 units box
-            set atom 1 diameter {2 * R} density {RHO} vx {V}
-            set atom 2 diameter {2 * R} density {RHO} vx {-V}
-            fix integrate all nve/sphere
-        """)
+        head_on(lg, V)
         ev = ContactEvents(lg)
         lg.run(1500)
         got = ev.take()
@@ -124,13 +129,7 @@ def test_events_catch_a_collision_shorter_than_the_sampling_interval(tmp_path):
     t_c = hertz_contact_time(2 * V)
     dt = t_c / 3.2                              # about 3 steps in contact
     with box(tmp_path, dt=dt) as lg:
-        lg.commands(f"""
-            create_atoms 1 single {-1.5 * R} 0 0 units box
-            create_atoms 1 single {1.5 * R} 0 0 units box
-            set atom 1 diameter {2 * R} density {RHO} vx {V}
-            set atom 2 diameter {2 * R} density {RHO} vx {-V}
-            fix integrate all nve/sphere
-        """)
+        head_on(lg, V)
         lg.add_pair_contacts()
         ev = ContactEvents(lg)
         lg.run(0)
