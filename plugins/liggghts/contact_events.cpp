@@ -304,6 +304,16 @@ int collheat_events_meshes(void *handle, int n, const char **ids, const double *
 // The next call records the contacts present as open, with no BEGIN events (a start or restart).
 void collheat_events_prime(void *handle) { static_cast<Recorder *>(handle)->primed = false; }
 
+// Record now, between runs, right after a set-up (its neighbour lists hold): walls given since
+// then take the contacts present as open, so that a contact beginning at the next step is an
+// event. (Otherwise the next call would take it: the first step after a restart, whose run
+// does no set-up that would call the recorder.)
+void collheat_events_sync(void *handle)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    rec->record(rec->lmp->update->ntimestep);
+}
+
 // Events waiting, open contacts now, and all BEGIN and END events recorded so far.
 int collheat_events_waiting(void *handle) { return int(static_cast<Recorder *>(handle)->rows.size() / ROW); }
 int collheat_events_open(void *handle) { return int(static_cast<Recorder *>(handle)->open_count()); }

@@ -313,7 +313,8 @@ class Dem:
 
     @collective
     def put_per_atom(self, ids, **arrays) -> None:
-        """Per-atom arrays given for all atoms by id (e.g. f=..., torque=...) into LIGGGHTS."""
+        """Per-atom arrays given for all atoms by id (e.g. f=..., torque=...) into LIGGGHTS, on
+        every rank; the next run starts without a set-up, which would compute the forces again."""
         self._order("put", ids, arrays)
         put_by_id(self.lmp, ids, arrays)
 

@@ -28,6 +28,7 @@ _DECLARATIONS = {
     "collheat_events_planes": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp]),
     "collheat_events_meshes": (_int, [_vp, _int, _c.POINTER(_c.c_char_p), _dp]),
     "collheat_events_prime": (None, [_vp]),
+    "collheat_events_sync": (None, [_vp]),
     "collheat_events_waiting": (_int, [_vp]),
     "collheat_events_open": (_int, [_vp]),
     "collheat_events_total": (_c.c_longlong, [_vp, _int]),
@@ -71,6 +72,11 @@ class ContactEvents:
     def prime(self) -> None:
         """The next step records the contacts there as open, without events (a (re)start)."""
         self.lmp.helper.collheat_events_prime(self.handle)
+
+    def sync(self) -> None:
+        """Record the contacts now, between runs: only right after a set-up (``run 0``), whose
+        neighbour lists hold; walls given since then take their contacts as open."""
+        self.lmp.helper.collheat_events_sync(self.handle)
 
     @property
     def waiting(self) -> int:

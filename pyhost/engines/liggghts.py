@@ -244,6 +244,11 @@ class Liggghts:
         self._execute(str(path), LiggghtsError, is_file=True)
         self._changed = True
 
+    def keep_set_up(self) -> None:
+        """The next run starts without a set-up, whatever came since the last one (the caller
+        put back what a set-up would recompute: a checkpoint's forces)."""
+        self._changed = False
+
     def run(self, steps: int) -> None:
         """Advance ``steps`` time steps as one chunk (``run N pre no post no``); the first run
         after any command does a full set-up (``pre yes``), tried first in a forked copy (an

@@ -80,7 +80,9 @@ def local_values(lmp, names) -> tuple:
 
 
 def put_by_id(lmp, ids, arrays: dict) -> None:
-    """Per-atom values given for all atoms by id: this rank's atoms take theirs."""
+    """Per-atom values given for all atoms by id: this rank's atoms take theirs. They stand
+    for the next run, which then starts without a set-up (that would compute the forces
+    again: see pyhost.checkpoint)."""
     here = lmp.atom("id").astype(np.int64)
     ids = np.asarray(ids, np.int64)
     lookup = np.full(int(max(ids.max(initial=0), here.max(initial=0))) + 1, -1, np.int64)
@@ -90,6 +92,7 @@ def put_by_id(lmp, ids, arrays: dict) -> None:
         raise ValueError(f"{int(np.sum(rows < 0))} atoms of LIGGGHTS are not among the ids given")
     for name, values in arrays.items():
         lmp.atom(name)[:] = np.asarray(values)[rows]
+    lmp.keep_set_up()
 
 
 def write_local(lmp, T=None, v=None, force=None, force_fix: str | None = None) -> None:
