@@ -122,12 +122,14 @@ class FluidSolver:
     and ``Cp``, ``kappa`` in transportProperties); :meth:`advance` then takes the heat of
     each cell (W), :meth:`temperature` gives the cells' T.
 
+    ``restart``: a folder of :meth:`save` to continue from (its time becomes the start time).
+
     Use ``with FluidSolver(case) as fluid: ...`` or :meth:`start` / :meth:`stop`.
     """
 
     def __init__(self, case: str | os.PathLike, *, nprocs: int = 1, drag: str = "gidaspow",
                  alpha_min: float = 0.3, timeout: float = TIMEOUT, energy: bool = False,
-                 void_fraction: str = "centre"):
+                 void_fraction: str = "centre", restart: str | os.PathLike | None = None):
         self.case = Path(case).resolve()
         if not (self.case / "system" / "controlDict").is_file():
             raise FluidError(f"{self.case} is not an OpenFOAM case (no system/controlDict)")
@@ -155,6 +157,7 @@ class FluidSolver:
         self._fds: list[tuple[int, int]] = []
         self._busy = False
         self.time = 0.0
+        self.restart = None if restart is None else Path(restart)
 
     # -- life cycle -------------------------------------------------------------------
     def start(self) -> "FluidSolver":
@@ -169,6 +172,9 @@ class FluidSolver:
                 shutil.rmtree(old)
             run_utility(self.case, "decomposePar", "-force")
             command = ["mpirun", "--oversubscribe", "-np", str(self.nprocs), *command, "-parallel"]
+        if self.restart is not None:
+            command.append("-restart")
+            self._start_from(self.restart)
         link = self.case / ".link"
         shutil.rmtree(link, ignore_errors=True)
         link.mkdir()
@@ -197,6 +203,12 @@ class FluidSolver:
         self._alpha, self._ksl, self._us = np.ones(n), np.zeros(n), np.zeros((n, 3))
         self.cell, self.slip = np.zeros(0, np.int64), np.zeros(0)
         self._busy = False
+        if self.restart is not None:
+            try:
+                self._resume(self.restart)
+            except BaseException:
+                self.stop()
+                raise
         return self
 
     def _connect(self, link: Path) -> tuple[list, list]:
@@ -233,6 +245,53 @@ class FluidSolver:
             self._kill()
             self.proc = None
             shutil.rmtree(self.case / ".link", ignore_errors=True)
+
+    def _time_folders(self) -> list[Path]:
+        """Where the solver writes a time: the case, or each rank's processor folder."""
+        return [self.case] if self.nprocs == 1 else [self.case / f"processor{r}" for r in range(self.nprocs)]
+
+    def save(self, folder: Path) -> float:
+        """The fluid's whole state at its current time into ``folder`` (created): every field
+        written with a double's 17 digits (:meth:`write`), that time's folder moved there from
+        the case (from each processor folder when decomposed), with the host's last exchange
+        (fraction, exchange coefficient and particle velocity sent, the particles' cells and
+        slip speeds, the boundary heat so far) in ``host.npz``. Returns the time [s]."""
+        before = [{p.name for p in d.iterdir()} for d in self._time_folders()]
+        t = self.write()
+        folder.mkdir(parents=True)
+        for d, old in zip(self._time_folders(), before):
+            new = [p for p in d.iterdir() if p.name not in old and p.is_dir() and _is_time(p.name)]
+            if len(new) != 1:
+                raise FluidError(f"the solver's write at t = {t:g} s left {len(new)} new time folders in {d}")
+            shutil.move(str(new[0]), folder / d.relative_to(self.case) / new[0].name)
+        np.savez(folder / "host.npz", alpha=self._alpha, ksl=self._ksl, us=self._us, cell=self.cell,
+                 slip=self.slip, boundary_heat=self.boundary_heat)
+        return t
+
+    def _start_from(self, folder: Path) -> None:
+        """Before the launch: ``folder``'s time (:meth:`save`) into the case as its start time."""
+        names = {p.name for d in self._time_folders() for p in (folder / d.relative_to(self.case)).glob("*")
+                 if p.is_dir() and _is_time(p.name)}
+        if len(names) != 1:
+            raise FluidError(f"{folder}: not a saved fluid state (time folders: {sorted(names) or 'none'})")
+        name = names.pop()
+        for d in self._time_folders():
+            shutil.rmtree(d / name, ignore_errors=True)
+            shutil.copytree(folder / d.relative_to(self.case) / name, d / name)
+        control = FoamFile(self.case / "system" / "controlDict")
+        control["startFrom"] = "startTime"
+        control["startTime"] = float(name)
+        self.time = float(name)
+
+    def _resume(self, folder: Path) -> None:
+        """At the end of a :meth:`start` from ``folder``: the host's side of the last exchange."""
+        with np.load(folder / "host.npz") as saved:
+            self._alpha, self._ksl, self._us = saved["alpha"], saved["ksl"], saved["us"]
+            self.cell, self.slip = saved["cell"], saved["slip"]
+            self.boundary_heat = float(saved["boundary_heat"])
+        if len(self._alpha) != len(self.cell_volumes):
+            raise FluidError(f"{folder}: the saved fluid has {len(self._alpha)} cells, the case "
+                             f"{len(self.cell_volumes)}")
 
     def _reconstruct(self) -> None:
         """A decomposed run's written times (``write()``) as whole fields in the case, as a
@@ -470,6 +529,14 @@ class FluidSolver:
             chunks.append(chunk)
             got += len(chunk)
         return np.frombuffer(b"".join(chunks), dtype=dtype)
+
+
+def _is_time(name: str) -> bool:
+    try:
+        float(name)
+    except ValueError:
+        return False
+    return True
 
 
 def _state(pid: int) -> str:
