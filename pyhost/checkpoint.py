@@ -12,6 +12,8 @@ coupling loop calls :func:`write` at the end of a step. It writes OUT/.checkpoin
 - ``host.json``: the host's values (totals, CT0, steps, warnings given, the byte size of
   collisions.csv, or the rows of the binary collision log, and of history.csv, and the VTK
   frames at this step);
+- ``fluid/`` (scenes with a fluid): the solver's fields at this time, written with 17 digits
+  (``FluidSolver.save``: the time folder, or each rank's, and the host's last exchange);
 - ``manifest.json`` last: the scene file's SHA-256, the code version (SHA-256 of pyhost/ and
   plugins/ sources), step, time, the run's end, and the SHA-256 of each file above;
 
@@ -41,7 +43,7 @@ from pyhost.cli import UserError
 from pyhost.outdir import write_atomic
 from pyhost.output import check_logs
 
-FOLDER, RESTART, FORMAT = "checkpoint", "dem.restart", 1
+FOLDER, RESTART, FLUID, FORMAT = "checkpoint", "dem.restart", "fluid", 1
 FILES = (RESTART, "host.npz", "host.json")
 ROOT = Path(__file__).resolve().parents[1]
 SOURCES = ("*.py", "*.C", "*.H", "*.cpp", "*.h")
@@ -82,9 +84,12 @@ def write(coupling) -> Path:
     values, arrays = coupling.state()
     np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **arrays)
     write_atomic(new / "host.json", json.dumps(values, indent=1))
+    if coupling.fluid is not None:
+        coupling.fluid.save(new / FLUID)
+    files = sorted(str(p.relative_to(new)) for p in new.rglob("*") if p.is_file())
     manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
                     code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
-                    files={name: _sha256(new / name) for name in FILES})
+                    files={name: _sha256(new / name) for name in files})
     write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
     shutil.rmtree(old, ignore_errors=True)
     if final.exists():
@@ -119,9 +124,6 @@ def refuse(scene) -> str | None:
         return ("a scene with its own LIGGGHTS script ([dem] script) cannot be restarted yet: the host would have "
                 "to rewrite the user's script (read_restart in place of its box, regions and insertion, with "
                 "every fix re-issued under its id); see docs/checkpoint.md")
-    if scene.effects.fluid:
-        return ("a scene with a fluid cannot be restarted yet: the fluid's time directory and the fluid force of "
-                "the last coupling are not part of a checkpoint; see docs/checkpoint.md")
     return None
 
 
@@ -137,8 +139,8 @@ def load(out: Path, scene) -> dict:
     if not folder.is_dir() and (Path(out) / ".checkpoint.old").is_dir():
         folder = Path(out) / ".checkpoint.old"    # a write was cut between its two renames
     if not folder.is_dir():
-        raise UserError(f"--restart: no checkpoint in {Path(out) / FOLDER} (give the scene output.checkpoint > 0, "
-                        "or stop a run with a signal once it has one)")
+        raise UserError(f"--restart: no checkpoint in {Path(out) / FOLDER} (a run writes one every output.checkpoint s, and "
+                        "when a signal stops it after its start; a SIGKILL or a lost node leaves only periodic ones)")
     try:
         manifest = json.loads((folder / "manifest.json").read_text())
         if not isinstance(manifest, dict) or not isinstance(manifest.get("files"), dict):
@@ -156,7 +158,8 @@ def load(out: Path, scene) -> dict:
     if manifest.get("end") != scene.time.end:
         raise UserError(f"--restart: {folder} is of a run to t = {manifest.get('end')} s, this one goes to "
                         f"{scene.time.end} s (--test given to one of them only?)")
-    for name in FILES:
+    needed = set(FILES) | ({f"{FLUID}/host.npz"} if scene.effects.fluid else set())
+    for name in sorted(needed | set(manifest["files"])):
         path = folder / name
         if not path.is_file():
             raise UserError(f"--restart: corrupt checkpoint: {path} is missing")
@@ -174,5 +177,6 @@ def load(out: Path, scene) -> dict:
     except (OSError, ValueError) as exc:
         raise UserError(f"--restart: {exc}") from None
     state["restart"] = folder / RESTART
+    state["fluid"] = folder / FLUID if scene.effects.fluid else None
     print(f"restart from {folder}: t = {manifest['time']:.6g} s (step {manifest['step']})")
     return state

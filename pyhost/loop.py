@@ -136,7 +136,9 @@ class Coupling:
                                  "capped", "clipped") + (FLUID_COLUMNS if fluid is not None else ())
                               + (GAS_COLUMNS if self.convection else ()), logs.get("history"))
         self.frames = VtkSeries(self.out / "vtk", "particles", logs.get("particles")) if scene.output.vtk else None
-        self.fluid_frames = VtkSeries(self.out / "vtk", "fluid") if fluid is not None and scene.output.vtk else None
+        self.fluid_frames = (VtkSeries(self.out / "vtk", "fluid", logs.get("fluid"))
+                             if fluid is not None and scene.output.vtk else None)
+        self.fluid_force = (np.zeros(0, np.int64), np.zeros((0, 3)))   # ids and force [N] of the last coupling
         self.progress = Progress(end or math.inf, progress_every)
         self.events = dem.events is not None     # contacts recorded inside LIGGGHTS (else sampled)
         sampled = self.effects["contact_extraction"] and (not self.events or dem.sampled_walls())
@@ -145,7 +147,10 @@ class Coupling:
                           frame=max(1, round(scene.output.every / dem.dt)),
                           couple=scene.time.couple_every if fluid is not None else 0,
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
+        if self.events:                      # the walls' contacts now are open ones: one that begins at
+            dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
+        self.restartable = checkpoint.refuse(scene) is None     # a signal's stop writes a checkpoint
         if resume is not None:
             self.restore(resume)
 
@@ -176,8 +181,9 @@ class Coupling:
 
     def advance(self, n: int) -> None:
         """n coupled DEM steps: the loop of the module doc. With checkpoints, a signal stops it
-        only at the end of a step, where the state is whole (``signals.deferred``)."""
-        with signals.deferred(bool(self.every["checkpoint"])):
+        only at the end of a step, where the state is whole (``signals.deferred``), and a
+        checkpoint is written there (``run_scene``), periodic checkpoints asked for or not."""
+        with signals.deferred(self.restartable):
             self._advance(n)
 
     def _advance(self, n: int) -> None:
@@ -248,11 +254,13 @@ class Coupling:
     def state(self) -> tuple[dict, dict]:
         """The host's state at the end of a step: (JSON values, arrays)."""
         logs = dict(collisions=self.collisions.mark(), history=self.history.mark(),
-                    particles=self.frames.frames if self.frames is not None else None)
+                    particles=self.frames.frames if self.frames is not None else None,
+                    fluid=self.fluid_frames.frames if self.fluid_frames is not None else None)
         values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, CT0=self.CT0,
                       gas_energy0=getattr(self, "gas_energy0", 0.0), warned=sorted(self.warned), logs=logs)
         arrays = dict(open_keys=self.tracker.open_keys, contact_info=self.info, CT_by_id=self.CT_by_id,
-                      seen=self.seen, M_by_id=self.M_by_id)
+                      seen=self.seen, M_by_id=self.M_by_id, fluid_ids=self.fluid_force[0],
+                      fluid_force=self.fluid_force[1])
         return values, arrays
 
     def restore(self, state: dict) -> None:
@@ -267,6 +275,13 @@ class Coupling:
         self.totals.setdefault("energy_mass_change", 0.0)
         self.totals.setdefault("outside_model_range", 0)
         checkpoint.restore_forces(self.dem, state)
+        if self.fluid is not None:          # the fluid force of the last coupling, until the next
+            ids, force = state["fluid_ids"], state["fluid_force"]
+            atoms = self.dem.atoms(False)
+            order = np.argsort(ids)
+            at = order[np.searchsorted(ids, atoms.id, sorter=order)]
+            self.dem.set_force(force[at])
+            self.fluid_force = (ids, force)
 
     # -- particles ----------------------------------------------------------------------
     def materials_of(self, types) -> np.ndarray:
@@ -574,6 +589,7 @@ class Coupling:
         forces = self.fluid.particle_forces(x, atoms.v, 2.0 * atoms.radius)
         self.fluid.advance(interval, heat=self.convect(atoms, interval) if self.convection else None)
         self.dem.set_force(forces)
+        self.fluid_force = (atoms.id.copy(), forces)
 
     def convect(self, atoms, interval: float) -> np.ndarray:
         """Gas-particle heat over the coming interval [s] (plugins.convection): each particle's
@@ -758,7 +774,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                               f"the script" + (", or the coupled time as [time] end" if fluid is not None else ""))
     except BaseException as exc:          # keep what was computed: summary of the run so far
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
-                and coupling.every["checkpoint"]:
+                and coupling.restartable:
             try:
                 coupling.flush_events()
                 checkpoint.write(coupling)

@@ -244,9 +244,9 @@ class Output:
     every: float = spec(">0", 1e-3, "interval between VTK frames [s]")
     vtk: bool = spec(default=True, doc="write VTK time series")
     pictures: bool = spec(default=True, doc="write PNG pictures")
-    checkpoint: float = spec(">=0", 0.0, "simulated time between checkpoints into OUT/checkpoint, also written "
-                             "when a signal stops the run; continue with 'run CASE --restart' [s]; 0: none. "
-                             "Box scenes without fluid only (docs/checkpoint.md)")
+    checkpoint: float = spec(">=0", 0.0, "simulated time between periodic checkpoints into OUT/checkpoint [s]; "
+                             "0: none. A signal (SIGTERM, SIGINT, SIGHUP) always writes one at the stop; continue "
+                             "with 'run CASE --restart'. Box scenes, with or without fluid (docs/checkpoint.md)")
     collisions: str = spec("in:csv,binary", "csv", "form of the collision log: 'csv', OUT/collisions.csv; 'binary', "
                            "one raw little-endian file per column in OUT/collisions/ with schema.json (cheaper "
                            "to write; read with pyhost.output.read_collisions, convert with "

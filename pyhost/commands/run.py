@@ -45,8 +45,8 @@ def _case_copy_filter(target: Path):
     return ignore
 
 
-def start_fluid(scene, folder: Path):
-    """The scene's fluid: a box case (pyhost.engines.fluid_case) over the domain and the plenum below
+def start_fluid(scene, folder: Path, restart: Path | None = None):
+    """The scene's fluid (``restart``: a checkpoint's saved fluid to continue from): a box case (pyhost.engines.fluid_case) over the domain and the plenum below
     it, inlet at its z lo, outlet at z hi, solved by collheatFoam every time.couple_every DEM
     steps. The inlet value is the fluid velocity there, so the superficial velocity asked for
     needs a particle-free inlet (a plenum) to be met. With convection the gas has a
@@ -73,7 +73,7 @@ def start_fluid(scene, folder: Path):
             props.update({"Cp": f.heat_capacity, "kappa": f.conductivity})
         _mesh(folder, source, str(scene.path))
         return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
-                           void_fraction=f.void_fraction).start()
+                           void_fraction=f.void_fraction, restart=restart).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
@@ -87,7 +87,7 @@ def start_fluid(scene, folder: Path):
                     T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
                     T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
     return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
-                           void_fraction=f.void_fraction).start()
+                       void_fraction=f.void_fraction, restart=restart).start()
 
 
 def _mesh(case: Path, source: Path, file: str) -> None:
@@ -235,7 +235,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     commands = read_script(script, scene.folder)
     if scene.scripted:
         check_types(commands, scene.materials, str(scene.path))
-    fluid = start_fluid(scene, out / "fluid") if effects["fluid_solver"] else None
+    fluid = start_fluid(scene, out / "fluid", resume and resume["fluid"]) if effects["fluid_solver"] else None
     cwd = os.getcwd()
     try:
         os.chdir(scene.folder)          # the script's relative paths, as with 'liggghts -in' there
