@@ -89,7 +89,8 @@ def write(coupling) -> Path:
     files = sorted(str(p.relative_to(new)) for p in new.rglob("*") if p.is_file())
     manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
                     code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
-                    files={name: _sha256(new / name) for name in files})
+                    files={name: _sha256(new / name) for name in files},
+                    inputs={str(f): _sha256(Path(f)) for f in coupling.inputs})
     write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
     shutil.rmtree(old, ignore_errors=True)
     if final.exists():
@@ -119,11 +120,8 @@ def restore_forces(dem, state: dict) -> None:
 
 
 def refuse(scene) -> str | None:
-    """Why this scene cannot be restarted (None: it can)."""
-    if scene.scripted:
-        return ("a scene with its own LIGGGHTS script ([dem] script) cannot be restarted yet: the host would have "
-                "to rewrite the user's script (read_restart in place of its box, regions and insertion, with "
-                "every fix re-issued under its id); see docs/checkpoint.md")
+    """Why this scene cannot be restarted (None: it can). Every scene can now; a script's
+    commands that a restart cannot replay are refused by ``pyhost.script.replay``."""
     return None
 
 
@@ -159,6 +157,10 @@ def load(out: Path, scene) -> dict:
         raise UserError(f"--restart: {folder} is of a run to t = {manifest.get('end')} s, this one goes to "
                         f"{scene.time.end} s (--test given to one of them only?)")
     needed = set(FILES) | ({f"{FLUID}/host.npz"} if scene.effects.fluid else set())
+    for name, sha in (manifest.get("inputs") or {}).items():
+        if not Path(name).is_file() or _sha256(Path(name)) != sha:
+            raise UserError(f"--restart: {name} is not the script the checkpoint's run read (changed or gone since): "
+                            "a restart replays the script as it was")
     for name in sorted(needed | set(manifest["files"])):
         path = folder / name
         if not path.is_file():

@@ -41,7 +41,7 @@ from pyhost.failures import particles_lost
 from pyhost.engines.liggghts import LiggghtsError
 from pyhost.outdir import write_atomic
 from pyhost.output import ColumnLog, CsvLog, Progress, VtkSeries, collision_kinds
-from pyhost.script import ScriptError, parse_run
+from pyhost.script import ScriptError, parse_run, replay
 
 HARVEST_EVERY = 1000
 """DEM steps between harvests of the contact events at most (they are also taken at every
@@ -149,7 +149,10 @@ class Coupling:
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
         if self.events:                      # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
+        self.command, self.run_left = -1, 0  # the script's run under way (its index) and its steps to go
+        self.inputs = ()                     # the script's files (a restart checks them)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
+        self.resumed = resume is not None    # the next advance continues the checkpoint's run
         self.restartable = checkpoint.refuse(scene) is None     # a signal's stop writes a checkpoint
         if resume is not None:
             self.restore(resume)
@@ -187,8 +190,10 @@ class Coupling:
             self._advance(n)
 
     def _advance(self, n: int) -> None:
-        if self.heat:
+        if self.heat and not self.resumed:  # (a restart continues a run: no script command came in between)
             self.resync()
+        self.resumed = False
+        self.run_left = n
         while n > 0:
             step = self.dem.step - self.t0_step
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
@@ -198,6 +203,7 @@ class Coupling:
             if self.keep_all is not None and self.dem.count() < len(self.before[1]):
                 self.lost()
             n -= chunk
+            self.run_left = n
             self.steps += chunk
             step += chunk
             self.t = self.dem.step * self.dem.dt
@@ -247,7 +253,8 @@ class Coupling:
             ids = atoms.id[known]
             m = np.where(self.M_by_id[ids] > 0, self.M_by_id[ids], atoms.mass[known])
             C = m * self.capacity[self.materials_of(atoms.type[known])]
-            self.totals["energy_set_by_script"] += float(np.sum(C * atoms.T[known]) - self.CT_by_id[ids].sum())
+            # atom by atom: an unchanged atom adds exactly 0, whatever the order LIGGGHTS holds them in
+            self.totals["energy_set_by_script"] += float(np.sum(C * atoms.T[known] - self.CT_by_id[ids]))
         self.track_particles(atoms)
 
     # -- checkpoint (pyhost.checkpoint writes and reads the files) ---------------------------
@@ -257,10 +264,13 @@ class Coupling:
                     particles=self.frames.frames if self.frames is not None else None,
                     fluid=self.fluid_frames.frames if self.fluid_frames is not None else None)
         values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, CT0=self.CT0,
-                      gas_energy0=getattr(self, "gas_energy0", 0.0), warned=sorted(self.warned), logs=logs)
+                      gas_energy0=getattr(self, "gas_energy0", 0.0), warned=sorted(self.warned), logs=logs,
+                      command=self.command, run_left=self.run_left, mesh_motion=self.dem.mesh_motion_times())
+        atoms = self.dem.atoms(self.heat)
         arrays = dict(open_keys=self.tracker.open_keys, contact_info=self.info, CT_by_id=self.CT_by_id,
                       seen=self.seen, M_by_id=self.M_by_id, fluid_ids=self.fluid_force[0],
-                      fluid_force=self.fluid_force[1])
+                      fluid_force=self.fluid_force[1], T_ids=atoms.id,
+                      T=atoms.T if self.heat else np.zeros(0))
         return values, arrays
 
     def restore(self, state: dict) -> None:
@@ -275,6 +285,12 @@ class Coupling:
         self.totals.setdefault("energy_mass_change", 0.0)
         self.totals.setdefault("outside_model_range", 0)
         checkpoint.restore_forces(self.dem, state)
+        self.dem.set_mesh_motion_times(state.get("mesh_motion", {}))
+        if self.heat and "T" in state:       # Temp as it was (a script's fix may not keep it in the restart)
+            atoms = self.dem.atoms(True)
+            ids, T = state["T_ids"], state["T"]
+            order = np.argsort(ids)
+            atoms.T[:] = T[order[np.searchsorted(ids, atoms.id, sorter=order)]]
         if self.fluid is not None:          # the fluid force of the last coupling, until the next
             ids, force = state["fluid_ids"], state["fluid_force"]
             atoms = self.dem.atoms(False)
@@ -726,7 +742,32 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     simulate no step at all is refused (ScriptError) rather than ending as done."""
     coupling = None
     effects = scene.effects_summary()
+    resume = particles.get("resume")
+    # a script restarted: its set-up replayed up to the run the checkpoint interrupted, that run's
+    # steps to go, then the rest as written (a box scene's generated script reads the restart itself)
+    restarting = resume is not None and scene.scripted
+    restart_from = int(resume["command"]) if restarting else 0
+    replayed = 0                        # the replayed set-up's length: commands[replayed] is the run
+    if restarting:
+        if not 0 <= restart_from < len(commands) or commands[restart_from].name != "run":
+            raise ScriptError(f"--restart: the checkpoint's run is command {restart_from} of {scene.path}'s "
+                              "script, which is not a run there (the script was changed?)")
+        setup = replay(commands, restart_from, resume["restart"])
+        commands, replayed = setup + commands[restart_from:], len(setup)
     last_run = max((k for k, c in enumerate(commands) if c.name == "run"), default=-1)
+    prepared = None
+
+    def prepare(cmd):
+        try:
+            added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
+                                fluid_force=fluid is not None,
+                                events=scene.time.contacts == "events"
+                                and dem.events_possible(scene.effects.restitution_feedback))
+        except LiggghtsError as exc:
+            raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
+        log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
+        return added
+
     try:
         for k, cmd in enumerate(commands):
             dem.context(cmd)
@@ -737,26 +778,33 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             if not dem.dt > 0:
                 raise ScriptError(f"{cmd.where()}: the time step is {dem.dt:g} s: give the script a positive "
                                   "'timestep' before its runs")
+            if k < replayed:                # a run before the restart's: the host's fixes come at the first
+                if prepared is None:
+                    prepared = prepare(cmd)
+                continue
             if coupling is None:
-                try:
-                    added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
-                                        fluid_force=fluid is not None,
-                                        events=scene.time.contacts == "events"
-                                        and dem.events_possible(scene.effects.restitution_feedback))
-                except LiggghtsError as exc:
-                    raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
-                log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
+                if prepared is None:
+                    prepared = prepare(cmd)
+                elif k == replayed:         # the replayed commands since the host's fixes: set up, then
+                    dem.run(0)              # the checkpoint's forces go back (Coupling's restore)
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, **particles)
+                if scene.scripted:           # a restart replays them: checked unchanged
+                    coupling.inputs = tuple(sorted({c.file for c in commands if c.file != "(host)"}))
                 coupling.start()
             else:
                 coupling.update_walls(walls_of(dem))
                 coupling.check_heat_gran()
-            try:
-                n = dem.steps(run.steps, run.upto)
-            except ScriptError as exc:
-                raise ScriptError(f"{cmd.where()}: {exc}") from None
-            if n == 0 and k == last_run and driven is not None:
+            coupling.command = k - replayed + restart_from
+            if restarting and k == replayed:
+                n = int(resume["run_left"])
+                log(f"{cmd.where()}: restarted in this run, {n} steps to go")
+            else:
+                try:
+                    n = dem.steps(run.steps, run.upto)
+                except ScriptError as exc:
+                    raise ScriptError(f"{cmd.where()}: {exc}") from None
+            if n == 0 and k == last_run and driven is not None and not (restarting and k == replayed):
                 n = round(driven / dem.dt)
                 log(f"{cmd.where()}: the script ends in a run of 0 steps, which the coupling drives: "
                     f"{driven:g} s ({n} steps; [time] end, else the fluid case's controlDict endTime)")

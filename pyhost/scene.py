@@ -246,7 +246,7 @@ class Output:
     pictures: bool = spec(default=True, doc="write PNG pictures")
     checkpoint: float = spec(">=0", 0.0, "simulated time between periodic checkpoints into OUT/checkpoint [s]; "
                              "0: none. A signal (SIGTERM, SIGINT, SIGHUP) always writes one at the stop; continue "
-                             "with 'run CASE --restart'. Box scenes, with or without fluid (docs/checkpoint.md)")
+                             "with 'run CASE --restart' (docs/checkpoint.md)")
     collisions: str = spec("in:csv,binary", "csv", "form of the collision log: 'csv', OUT/collisions.csv; 'binary', "
                            "one raw little-endian file per column in OUT/collisions/ with schema.json (cheaper "
                            "to write; read with pyhost.output.read_collisions, convert with "

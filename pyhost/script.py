@@ -143,6 +143,48 @@ def _check_if(cmd: Command) -> None:
             raise ScriptError(f"{cmd.where()}: '{name}' inside 'if': {why}")
 
 
+BOX = ("create_box", "read_data", "read_restart")
+STATE = {"create_atoms", "delete_atoms", "displace_atoms", "set", "velocity", "read_dump", "change_box",
+         "reset_timestep", "group", "write_restart", "write_data", "write_dump", "print", "create_box",
+         "read_data", "read_restart"}
+"""Commands whose effect is in LIGGGHTS' restart file (atoms and their values, groups, the box,
+the step) or that only wrote output: a restart does not replay them."""
+
+
+def replay(commands: list[Command], upto: int, restart: Path) -> list[Command]:
+    """The set-up of a script restarted at its command number ``upto`` (a ``run`` that a
+    checkpoint interrupted): commands[:upto] with the first box command (create_box, read_data,
+    read_restart) replaced by ``read_restart`` of the checkpoint's file, what the file holds
+    (``STATE``) left out, and the rest (regions, variables, fixes and unfixes under their ids,
+    which take their state back from the file, computes, pair style, dumps) replayed in order;
+    a dump or log to one file appends to it. Earlier runs stay in the list as markers (the
+    host adds its own fixes at the first, as in the run that wrote the checkpoint); they
+    simulate nothing. ScriptError for a command whose effect the host cannot know (an ``if``)."""
+    out, box = [], False
+    for cmd in commands[:upto]:
+        name = cmd.name
+        if name == "if":
+            raise ScriptError(f"--restart: {cmd.where()}: an 'if' before the interrupted run; the host cannot "
+                              "tell what it did, so it cannot restart this script (move it after the last run, "
+                              "or give the values as variables)")
+        if name in BOX and not box:
+            box = True
+            out.append(Command(f"read_restart {restart}", cmd.file, cmd.line))
+            continue
+        if name in STATE:
+            continue
+        out.append(cmd)
+        words = cmd.words
+        if name == "dump" and len(words) >= 6 and "*" not in words[5] and "%" not in words[5]:
+            out.append(Command(f"dump_modify {words[1]} append yes", cmd.file, cmd.line))
+        if name == "log" and len(words) == 2:
+            out[-1] = Command(f"log {words[1]} append", cmd.file, cmd.line)
+    if not box:
+        raise ScriptError(f"--restart: the script defines no box (create_box, read_data or read_restart) before "
+                          f"{commands[upto].where()}")
+    return out
+
+
 @dataclass(frozen=True)
 class RunCommand:
     """``run N [upto] [pre yes|no] [post yes|no]``: steps (possibly a $variable, evaluated by
@@ -242,6 +284,7 @@ class ScriptInfo:
     pair_model: str = ""                                # the pair style's normal model
     globals: dict = field(default_factory=dict)         # property/global name -> fix id
     periodic: tuple = (False, False, False)             # from the boundary command
+    mesh_motions: list = field(default_factory=list)    # ids of the fix move/mesh defined now
 
     def wall_type(self, fix: str, mesh: int = 0) -> int | None:
         """The LIGGGHTS atom type of a wall fix's primitive, or of its mesh number ``mesh``."""
@@ -264,8 +307,12 @@ class ScriptInfo:
                 self.temp_fix = True
             elif style == "property/global" and len(w) >= 5:
                 self.globals[w[4]] = w[1]
+            elif style.startswith("move/mesh") and w[1] not in self.mesh_motions:
+                self.mesh_motions.append(w[1])
         elif w[0] == "unfix" and len(w) == 2:
             self.walls.pop(w[1], None)
+            if w[1] in self.mesh_motions:
+                self.mesh_motions.remove(w[1])
             if self.heat_gran == w[1]:
                 self.heat_gran = None
         elif w[0] == "compute" and len(w) >= 4 and w[3] in ("pair/gran/local", "wall/gran/local"):

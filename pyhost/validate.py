@@ -109,9 +109,6 @@ def check_scene(scene) -> None:
     file, d, tm = scene.path, scene.domain, scene.time
     if scene.fluid is not None and not scene.fluid.alpha_min < 1:
         raise SceneError(f"{file}: fluid.alpha_min: must be in (0, 1), got {scene.fluid.alpha_min!r}")
-    if scene.output.checkpoint and scene.scripted:
-        raise SceneError(f"{file}: output.checkpoint: checkpoints are made for box scenes only; this scene has "
-                         "a LIGGGHTS script (docs/checkpoint.md says why)")
     if scene.fluid is not None and scene.effects.fluid:
         ranks = scene.fluid.ranks
         if scene.fluid.case:

@@ -230,8 +230,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
             print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
                   f"({t_c:.3g} s) with fewer than 20 steps")
         script, particles = box_world(scene, out, start, resume and resume["restart"])
-        particles["resume"] = resume
         variables = {}
+    particles["resume"] = resume
     commands = read_script(script, scene.folder)
     if scene.scripted:
         check_types(commands, scene.materials, str(scene.path))

@@ -318,6 +318,20 @@ class Dem:
         self._order("put", ids, arrays)
         put_by_id(self.lmp, ids, arrays)
 
+    def mesh_motion_times(self) -> dict:
+        """The time [s] of each fix move/mesh of the script (its phase: see
+        ``Liggghts.move_mesh_time``), by fix id."""
+        return {fix: self.lmp.move_mesh_time(fix) for fix in self.info.mesh_motions}
+
+    @collective
+    def set_mesh_motion_times(self, times: dict) -> None:
+        """Give each fix move/mesh its time back (a restart), on every rank."""
+        if not times:
+            return
+        self._order("mesh_times", times)
+        for fix, t in times.items():
+            self.lmp.move_mesh_time(fix, t)
+
     def engine_command(self, line: str) -> None:
         """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""
         self._raw(line)

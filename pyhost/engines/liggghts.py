@@ -64,6 +64,7 @@ _HELPER_DECLARATIONS = {
     "collheat_compute_local": (_int, [_vp, _cp, _c.POINTER(_int), _c.POINTER(_int),
                                       _c.POINTER(_c.POINTER(_c.c_double))]),
     "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
+    "collheat_move_mesh_time": (_int, [_vp, _cp, _c.POINTER(_c.c_double), _int]),
 }
 
 # Per-atom arrays: name -> (ctype, columns; 0 for a vector).
@@ -414,6 +415,15 @@ class Liggghts:
         if not raw:
             raise LiggghtsError(f"no 'fix {fix_id} ... external pf/array' (or no run yet)")
         return np.ctypeslib.as_array(raw, shape=(self.nlocal, 3))
+
+    def move_mesh_time(self, fix_id: str, value: float | None = None) -> float:
+        """The time [s] of ``fix <fix_id> ... move/mesh`` since its motion began (its phase);
+        with ``value``, set it first. LIGGGHTS' restart files do not keep it (see
+        plugins/liggghts/restart_state.cpp)."""
+        t = ctypes.c_double(0.0 if value is None else value)
+        if self.helper.collheat_move_mesh_time(self.ptr, fix_id.encode(), ctypes.byref(t), int(value is not None)):
+            raise LiggghtsError(f"no 'fix {fix_id} ... move/mesh'")
+        return t.value
 
     # -- contacts ---------------------------------------------------------------------
     def add_pair_contacts(self, compute_id: str = "pairs") -> None:

@@ -225,6 +225,10 @@ class Follower:
     def do_per_atom(self, names) -> None:
         self.comm.gather(local_values(self.lmp, names), root=ROOT)
 
+    def do_mesh_times(self, times) -> None:
+        for fix, t in times.items():
+            self.lmp.move_mesh_time(fix, t)
+
     def do_put(self, ids, arrays) -> None:
         put_by_id(self.lmp, ids, arrays)
 

@@ -54,6 +54,16 @@ def pyhost(*args, stop: tuple | None = None) -> subprocess.CompletedProcess:
                           env=dict(os.environ, PYTHONPATH=str(ROOT)))
 
 
+def sigterm_and_restart(folder: Path, out: Path, step: int) -> tuple:
+    """``run FOLDER --test`` into OUT stopped by SIGTERM at STEP (exit 143), then ``--restart``
+    (exit 0): the two runs' stdout."""
+    r = pyhost("run", folder, "--test", "--out", out, stop=(step, "SIGTERM"))
+    assert r.returncode == 143, r.stderr[-2000:]
+    again = pyhost("run", folder, "--test", "--out", out, "--restart")
+    assert again.returncode == 0, again.stderr[-2000:]
+    return r.stdout, again.stdout
+
+
 def outputs(out: Path) -> dict:
     files = ["collisions.csv", "history.csv", "vtk/particles.pvd"] + sorted(
         str(p.relative_to(out)) for p in (out / "vtk").glob("*.vtu"))
@@ -161,11 +171,8 @@ def test_bed_stopped_by_sigterm_and_restarted_equals_to_its_chaos_level(bed, tmp
     Asserted: 10x the chaos level; energy conserved to rounding; rows before the stop equal."""
     folder, whole = bed
     out = tmp_path / "out"
-    r = pyhost("run", folder, "--test", "--out", out, stop=(6003, "SIGTERM"))
-    assert r.returncode == 143, r.stderr[-2000:]
-    assert "checkpoint at t = 0.007 s (step 7000)" in r.stdout
-    r = pyhost("run", folder, "--test", "--out", out, "--restart")
-    assert r.returncode == 0, r.stderr[-2000:]
+    stopped, restarted = sigterm_and_restart(folder, out, 6003)
+    assert "checkpoint at t = 0.007 s (step 7000)" in stopped
     a, b = summary(out), summary(whole)
     assert abs(a["heat_moved"] / b["heat_moved"] - 1) < 2.5e-4
     assert abs(a["collisions"] - b["collisions"]) <= 20
@@ -245,17 +252,77 @@ def test_restart_and_overwrite_together_are_refused(stopped, capsys):
     assert "give one" in refused(capsys, "run", case_dir, "--out", out, "--restart", "--overwrite")
 
 
-def test_scripted_scenes_refuse_restart(tmp_path, capsys):
-    """Not built yet for a user's script (docs/checkpoint.md): a clear refusal, for the key and
-    for --restart."""
-    folder = tmp_path / "silo-heat"
-    shutil.copytree(ROOT / "cases" / "silo-heat", folder, ignore=shutil.ignore_patterns("output"))
-    assert "own LIGGGHTS script" in refused(capsys, "run", folder, "--out", tmp_path / "out", "--restart")
+# -- a user's script: its set-up replayed with the checkpoint's state in place of its box ------------
+
+def silo(tmp: Path, checkpoint: float | None = None) -> Path:
+    """A copy of cases/silo-heat (its own script: STL tube and shaken plate, two poured
+    materials, fix heat/gran, its own dumps), with no pictures."""
+    folder = tmp / "silo-heat"
+    shutil.copytree(ROOT / "cases" / "silo-heat", folder, ignore=shutil.ignore_patterns("output", "post"))
     toml = folder / "case.toml"
-    toml.write_text(toml.read_text().replace("[output]", "[output]\ncheckpoint = 0.01", 1)
-                    if "[output]" in toml.read_text() else toml.read_text() + "\n[output]\ncheckpoint = 0.01\n")
-    assert "output.checkpoint: checkpoints are made for box scenes only" in refused(
-        capsys, "run", folder, "--out", tmp_path / "out2")
+    toml.write_text(toml.read_text() + "pictures = false\n" + (f"checkpoint = {checkpoint}\n" if checkpoint else ""))
+    return folder
+
+
+def test_script_stopped_while_shaking_restarts_bit_for_bit(tmp_path):
+    """silo-heat --test (no output.checkpoint) stopped by SIGTERM at step 15003, in its third run
+    (the plate shaken by fix move/mesh since step 14001): a checkpoint at step 15005, then
+    --restart replays the script's set-up with read_restart in place of create_box, gives the
+    plate its motion's time back (LIGGGHTS' restart file does not keep it: without it the plate
+    left its path and the bed had 30 % more collisions) and runs the 995 steps to go. Collisions,
+    history, summary and the script's own last dump equal byte for byte the run that wrote a
+    checkpoint at that step and went on."""
+    marked = silo(tmp_path / "marked", checkpoint=0.075025)
+    folder = silo(tmp_path)
+    r = pyhost("run", marked, "--test", "--out", tmp_path / "marked-out")
+    assert r.returncode == 0, r.stderr[-2000:]
+    out = tmp_path / "out"
+    stopped, restarted = sigterm_and_restart(folder, out, 15003)
+    assert "checkpoint at t = 0.075025 s (step 15005)" in stopped
+    assert "in.liggghts:102: restarted in this run, 995 steps to go" in restarted
+    assert outputs(out) == outputs(tmp_path / "marked-out")
+    assert summary(out) == summary(tmp_path / "marked-out")
+    last = "post/particles_16000.dump"
+    assert (folder / last).read_bytes() == (marked / last).read_bytes()
+
+
+def test_script_stopped_while_pouring_restarts(tmp_path):
+    """silo-heat --test stopped by SIGTERM at step 6003, in its first run, while the two
+    insertions still pour: --restart completes the run with all 900 particles inserted, energy
+    balanced to rounding, and the collisions before the stop unchanged. The next insertion
+    (step 8001) draws other positions than the run never stopped (although LIGGGHTS'
+    insertion, template and distribution fixes write their random states; cause not found),
+    so the rest is a statistically equal pour: measured, 7,914 collisions against 7,832, heat moved 1.9 % apart. Asserted:
+    within 10 %."""
+    folder = silo(tmp_path)
+    whole, out = tmp_path / "whole", tmp_path / "out"
+    r = pyhost("run", folder, "--test", "--out", whole)
+    assert r.returncode == 0, r.stderr[-2000:]
+    sigterm_and_restart(folder, out, 6003)
+    a, b = summary(out), summary(whole)
+    print(f"collisions {a['collisions']} against {b['collisions']}, heat moved {a['heat_moved'] / b['heat_moved'] - 1:+.2e}")
+    assert a["status"] == "completed" and a["steps"] == b["steps"] == 16000 and a["inserted"] == 900
+    assert abs(a["energy_balance_error"]) < 1e-12
+    assert a["collisions"] == pytest.approx(b["collisions"], rel=0.1)
+    assert a["heat_moved"] == pytest.approx(b["heat_moved"], rel=0.1)
+    before = [ln for ln in (whole / "collisions.csv").read_text().splitlines()[1:] if float(ln.split(",")[0]) <= 0.03]
+    assert (out / "collisions.csv").read_text().splitlines()[1:len(before) + 1] == before
+
+
+def test_restart_of_an_edited_script_is_refused(tmp_path, capsys):
+    """A restart replays the script as the checkpoint's run read it: an edited script is
+    refused (exit 2), the checkpoint left as it was."""
+    folder = silo(tmp_path)
+    out = tmp_path / "out"
+    r = pyhost("run", folder, "--test", "--out", out, stop=(2003, "SIGTERM"))
+    assert r.returncode == 143, r.stderr[-2000:]
+    script = folder / "in.liggghts"
+    script.write_text(script.read_text().replace("vel constant 0. 0. -0.3 set_property Temp 400.",
+                                                 "vel constant 0. 0. -0.5 set_property Temp 400."))
+    before = fingerprint(out / "checkpoint")
+    assert "in.liggghts is not the script the checkpoint's run read" in refused(
+        capsys, "run", folder, "--test", "--out", out, "--restart")
+    assert fingerprint(out / "checkpoint") == before
 
 
 # -- fluid scenes: the solver's fields at the checkpoint (17 digits), its restart from them ----------
@@ -306,11 +373,8 @@ def test_bed_stopped_by_sigterm_without_checkpoints_restarts(tmp_path):
     for f, o in ((folder, whole), (marked, tmp_path / "marked-out")):
         r = pyhost("run", f, "--test", "--out", o)
         assert r.returncode == 0, r.stderr[-2000:]
-    r = pyhost("run", folder, "--test", "--out", out, stop=(6253, "SIGTERM"))
-    assert r.returncode == 143, r.stderr[-2000:]
-    assert "checkpoint at t = 0.0251 s (step 6275)" in r.stdout
-    r = pyhost("run", folder, "--test", "--out", out, "--restart")
-    assert r.returncode == 0, r.stderr[-2000:]
+    stopped, restarted = sigterm_and_restart(folder, out, 6253)
+    assert "checkpoint at t = 0.0251 s (step 6275)" in stopped
     assert outputs(out) == outputs(tmp_path / "marked-out")
     assert summary(out) == summary(tmp_path / "marked-out")
     a, b = summary(out), summary(whole)
