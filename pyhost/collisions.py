@@ -36,7 +36,7 @@ class ContactTracker:
     """The open contacts between two samples of the contact list.
 
     ``update(keys)`` returns the indices (into keys) of contacts that opened since the last
-    sample and the keys of those that closed (in the order of the last sample); ``match(keys)``
+    sample and the keys of those that closed (both in key order); ``match(keys)``
     also says where each contact was in the last sample, so that the host keeps per-contact
     data in arrays aligned with ``open_keys``. Membership by binary search in sorted copies.
     """
@@ -48,8 +48,11 @@ class ContactTracker:
 
     def match(self, keys: np.ndarray):
         """(opened: indices into keys of the new contacts; closed: indices into the last
-        ``open_keys`` of those gone, in order; prev: for each key its index in the last
-        ``open_keys``, -1 for a new one); ``open_keys`` becomes a copy of keys."""
+        ``open_keys`` of those gone; prev: for each key its index in the last ``open_keys``, -1
+        for a new one); ``open_keys`` becomes a copy of keys. opened and closed come in the
+        order of their keys, not of the engine's list, whose order follows the atoms' order in
+        memory (a restart or another number of ranks changes it): the host moves heat and
+        restitution impulses in this order, so it must not depend on the engine's."""
         keys = np.asarray(keys, np.int64)
         order = np.argsort(keys, kind="stable")
         ordered = keys[order]
@@ -60,8 +63,8 @@ class ContactTracker:
             at = np.minimum(np.searchsorted(self._sorted, keys), len(self._sorted) - 1)
             hit = self._sorted[at] == keys
             prev[hit] = self._order[at[hit]]
-        opened = np.flatnonzero(prev < 0)
-        closed = np.flatnonzero(~_member(self.open_keys, ordered))
+        opened = order[prev[order] < 0]
+        closed = self._order[~_member(self._sorted, ordered)]
         self.open_keys, self._sorted, self._order = keys.copy(), ordered, order
         return opened, closed, prev
 

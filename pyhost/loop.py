@@ -154,6 +154,7 @@ class Coupling:
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
         self.resumed = resume is not None    # the next advance continues the checkpoint's run
         self.restartable = checkpoint.refuse(scene) is None     # a signal's stop writes a checkpoint
+        self.checkpoint_step = -1            # the step of the last checkpoint written
         if resume is not None:
             self.restore(resume)
 
@@ -265,7 +266,8 @@ class Coupling:
                     fluid=self.fluid_frames.frames if self.fluid_frames is not None else None)
         values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, CT0=self.CT0,
                       gas_energy0=getattr(self, "gas_energy0", 0.0), warned=sorted(self.warned), logs=logs,
-                      command=self.command, run_left=self.run_left, mesh_motion=self.dem.mesh_motion_times())
+                      command=self.command, run_left=self.run_left, mesh_motion=self.dem.mesh_motion_times(),
+                      randoms=self.dem.random_states())
         atoms = self.dem.atoms(self.heat)
         arrays = dict(open_keys=self.tracker.open_keys, contact_info=self.info, CT_by_id=self.CT_by_id,
                       seen=self.seen, M_by_id=self.M_by_id, fluid_ids=self.fluid_force[0],
@@ -286,6 +288,7 @@ class Coupling:
         self.totals.setdefault("outside_model_range", 0)
         checkpoint.restore_forces(self.dem, state)
         self.dem.set_mesh_motion_times(state.get("mesh_motion", {}))
+        self.dem.set_random_states(state.get("randoms", {}))
         if self.heat and "T" in state:       # Temp as it was (a script's fix may not keep it in the restart)
             atoms = self.dem.atoms(True)
             ids, T = state["T_ids"], state["T"]
@@ -485,6 +488,9 @@ class Coupling:
         if still.any():
             self.totals["contacts_without_impact"] = self.totals.get("contacts_without_impact", 0) + int(still.sum())
         begin = begin[here & ~still]
+        # in the order of step, then ids: not of the recorder's lists, which follow the atoms'
+        # order in memory (a restart or another number of ranks changes it)
+        begin = begin[np.lexsort((begin["j"], begin["i"], begin["wall"], begin["step"]))]
         if len(begin):
             self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["n"], begin["step"] * self.dem.dt)
 
@@ -822,7 +828,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                               f"the script" + (", or the coupled time as [time] end" if fluid is not None else ""))
     except BaseException as exc:          # keep what was computed: summary of the run so far
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
-                and coupling.restartable:
+                and coupling.restartable and coupling.checkpoint_step != dem.step:   # (not twice at one step)
             try:
                 coupling.flush_events()
                 checkpoint.write(coupling)

@@ -185,6 +185,12 @@ def replay(commands: list[Command], upto: int, restart: Path) -> list[Command]:
     return out
 
 
+RANDOMS = {"insert": ("insert",), "particledistribution/discrete": ("distribution",),
+           "particletemplate/sphere": ("template_insertion", "template_mc")}
+"""Fix styles (insert/* as "insert") whose random generators a restart puts back, by the kind
+``Liggghts.random_state`` knows them as."""
+
+
 @dataclass(frozen=True)
 class RunCommand:
     """``run N [upto] [pre yes|no] [post yes|no]``: steps (possibly a $variable, evaluated by
@@ -285,6 +291,7 @@ class ScriptInfo:
     globals: dict = field(default_factory=dict)         # property/global name -> fix id
     periodic: tuple = (False, False, False)             # from the boundary command
     mesh_motions: list = field(default_factory=list)    # ids of the fix move/mesh defined now
+    randoms: list = field(default_factory=list)         # "what id" of insertion's random generators
 
     def wall_type(self, fix: str, mesh: int = 0) -> int | None:
         """The LIGGGHTS atom type of a wall fix's primitive, or of its mesh number ``mesh``."""
@@ -292,6 +299,12 @@ class ScriptInfo:
         if wall is None:
             return None
         return wall.type if wall.primitive is not None else self.mesh_types.get(wall.meshes[mesh])
+
+    def _random(self, key: str, defined: bool) -> None:
+        if key in self.randoms:
+            self.randoms.remove(key)
+        if defined:
+            self.randoms.append(key)
 
     def learn(self, cmd: Command) -> None:
         w = cmd.words
@@ -309,15 +322,20 @@ class ScriptInfo:
                 self.globals[w[4]] = w[1]
             elif style.startswith("move/mesh") and w[1] not in self.mesh_motions:
                 self.mesh_motions.append(w[1])
+            for what in RANDOMS.get(style.split("/")[0] if style.startswith("insert/") else style, ()):
+                self._random(f"{what} {w[1]}", True)
         elif w[0] == "unfix" and len(w) == 2:
             self.walls.pop(w[1], None)
             if w[1] in self.mesh_motions:
                 self.mesh_motions.remove(w[1])
+            self.randoms = [k for k in self.randoms if k.split(" ", 1)[1] != w[1] or k.startswith("region ")]
             if self.heat_gran == w[1]:
                 self.heat_gran = None
         elif w[0] == "compute" and len(w) >= 4 and w[3] in ("pair/gran/local", "wall/gran/local"):
             which = "pair_compute" if w[3] == "pair/gran/local" else "wall_compute"
             setattr(self, which, (w[1], w[4:]))
+        elif w[0] == "region" and len(w) >= 3:
+            self._random("region " + w[1], w[2] != "delete")
         elif w[0] == "boundary" and len(w) >= 4:
             self.periodic = tuple(b == "p" for b in w[1:4])
         elif w[0] == "pair_style" and len(w) >= 4 and w[1] == "gran" and w[2] == "model":

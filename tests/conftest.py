@@ -102,3 +102,22 @@ IN_PROCESS_ENGINE = ("tests/engines/test_liggghts.py",
 def pytest_collection_modifyitems(config, items):
     last = [item for item in items if item.nodeid.startswith(IN_PROCESS_ENGINE)]
     items[:] = [item for item in items if item not in last] + last
+
+
+# ``python -c STOPPER STEP SIGNAL run CASE ...``: pyhost's CLI, whose DEM sends itself SIGNAL (a
+# name: SIGTERM, SIGKILL, ...) after the first chunk that reaches STEP (a batch system's stop).
+STOPPER = """
+import os, signal, sys
+import pyhost.commands.run as r
+from pyhost.cli import main
+at, sig = int(sys.argv[1]), getattr(signal, sys.argv[2])
+class Stopping:
+    def __init__(self, dem): self.dem = dem
+    def run(self, n):
+        self.dem.run(n)
+        if self.dem.step >= at: os.kill(os.getpid(), sig)
+    def __getattr__(self, name): return getattr(self.dem, name)
+simulate = r.simulate
+r.simulate = lambda *a, **k: simulate(*a, wrap=Stopping, **k)
+sys.exit(main(sys.argv[3:]))
+"""

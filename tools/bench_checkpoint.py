@@ -60,8 +60,8 @@ def main() -> None:
     from pyhost.scene import load_scene
 
     case = Path(args.case).resolve()
-    scene = load_scene(case / "case.toml", test=True)
-    end = scene.time.end
+    scene = load_scene(case / "case.toml")
+    end = scene.time.test_end or scene.time.end / 10          # what --test runs (pyhost.commands.run)
     every = end / (args.count + 0.5)          # not at the end: the last one would not be a periodic cost
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

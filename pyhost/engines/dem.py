@@ -27,7 +27,7 @@ import numpy as np
 
 from pyhost.collisions import WALL_BASE
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
-from pyhost.engines.ranks import collective, gather_arrays, local_atoms, local_values, put_by_id, write_local
+from pyhost.engines.ranks import local_random_states, set_random_states, collective, gather_arrays, local_atoms, local_values, put_by_id, write_local
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 
 FLUID_FIX = "collheat_fluid"
@@ -331,6 +331,27 @@ class Dem:
         self._order("mesh_times", times)
         for fix, t in times.items():
             self.lmp.move_mesh_time(fix, t)
+
+    @collective
+    def random_states(self) -> dict:
+        """The state of each random generator of the script's insertion (its regions, insert,
+        distribution and template fixes), by "what id": one per rank."""
+        keys = list(self.info.randoms)
+        if self.link is not None:
+            self._order("random_states", keys)
+        mine = local_random_states(self.lmp, keys)
+        every = [mine] if self.link is None else self.link.gather(mine)
+        return {k: [m[k] for m in every] for k in mine if all(k in m for m in every)}
+
+    @collective
+    def set_random_states(self, states: dict) -> None:
+        """Put those states back (a restart), each rank its own. On another number of ranks
+        than the run that saved them, LIGGGHTS' own reset stays: a restart on other ranks is
+        another decomposition anyway."""
+        if not states:
+            return
+        self._order("set_random_states", states)
+        set_random_states(self.lmp, states, 0, 1 if self.link is None else self.link.size)
 
     def engine_command(self, line: str) -> None:
         """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""

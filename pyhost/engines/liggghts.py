@@ -65,6 +65,7 @@ _HELPER_DECLARATIONS = {
                                       _c.POINTER(_c.POINTER(_c.c_double))]),
     "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
     "collheat_move_mesh_time": (_int, [_vp, _cp, _c.POINTER(_c.c_double), _int]),
+    "collheat_random_state": (_int, [_vp, _cp, _cp, _c.POINTER(_int), _int]),
 }
 
 # Per-atom arrays: name -> (ctype, columns; 0 for a vector).
@@ -424,6 +425,17 @@ class Liggghts:
         if self.helper.collheat_move_mesh_time(self.ptr, fix_id.encode(), ctypes.byref(t), int(value is not None)):
             raise LiggghtsError(f"no 'fix {fix_id} ... move/mesh'")
         return t.value
+
+    def random_state(self, what: str, id_: str, value: int | None = None) -> int | None:
+        """The state of one of insertion's random generators on this rank (None: there is none):
+        ``what`` is "region", "insert", "distribution", "template_insertion" or "template_mc",
+        ``id_`` the region's or fix's id; with ``value``, set it first. LIGGGHTS' restart does
+        not bring them all back (see plugins/liggghts/restart_state.cpp)."""
+        s = ctypes.c_int(0 if value is None else value)
+        if self.helper.collheat_random_state(self.ptr, what.encode(), id_.encode(), ctypes.byref(s),
+                                             int(value is not None)):
+            return None
+        return s.value
 
     # -- contacts ---------------------------------------------------------------------
     def add_pair_contacts(self, compute_id: str = "pairs") -> None:

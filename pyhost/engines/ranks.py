@@ -105,6 +105,20 @@ def write_local(lmp, T=None, v=None, force=None, force_fix: str | None = None) -
         lmp.external_force(force_fix)[:] = force
 
 
+def local_random_states(lmp, keys) -> dict:
+    """This rank's state of each random generator named "what id" (``Liggghts.random_state``)."""
+    found = {k: lmp.random_state(*k.split(" ", 1)) for k in keys}
+    return {k: v for k, v in found.items() if v is not None}
+
+
+def set_random_states(lmp, states: dict, rank: int, size: int) -> None:
+    """Each random generator's state saved by this rank, when the run has as many ranks as the
+    one that saved them."""
+    for key, per_rank in states.items():
+        if len(per_rank) == size:
+            lmp.random_state(*key.split(" ", 1), int(per_rank[rank]))
+
+
 class Link:
     """Rank 0's side: orders to the followers, and the collective data exchanges."""
 
@@ -228,6 +242,12 @@ class Follower:
     def do_mesh_times(self, times) -> None:
         for fix, t in times.items():
             self.lmp.move_mesh_time(fix, t)
+
+    def do_random_states(self, keys) -> None:
+        self.comm.gather(local_random_states(self.lmp, keys), root=ROOT)
+
+    def do_set_random_states(self, states) -> None:
+        set_random_states(self.lmp, states, self.comm.Get_rank(), self.comm.Get_size())
 
     def do_put(self, ids, arrays) -> None:
         put_by_id(self.lmp, ids, arrays)

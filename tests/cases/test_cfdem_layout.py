@@ -155,3 +155,39 @@ def test_a_dry_script_whose_runs_simulate_nothing_is_refused(tmp_path):
     r = run(cfd)
     assert r.returncode == 2, r.stdout[-2000:] + r.stderr[-2000:]
     assert "the script's runs simulate no step" in r.stderr and "in.liggghts_run:" in r.stderr
+
+
+def test_cfdem_layout_stopped_and_restarted_is_the_run_never_stopped(tmp_path):
+    """The user's OpenFOAM case and script stopped by SIGTERM at step 5003 of the driven
+    ``run 0 upto`` (no output.checkpoint: the signal writes one at the end of the coupling
+    interval under way, step 5100), then --restart: the script replayed, the solver started
+    from the saved fields, the rest of the driven run. history.csv, the VTK series and the
+    summary equal byte for byte a run that wrote a checkpoint at that step; the sphere's
+    velocity printed by the script's own fix print after the restart is the same to the last
+    digit (the fix opens its file again, so it holds only the rows after the restart:
+    docs/checkpoint.md)."""
+    from conftest import STOPPER
+    marked = cfdem_case(tmp_path / "marked")
+    (marked / "case.toml").write_text((marked / "case.toml").read_text() + "\n[output]\ncheckpoint = 0.051\n")
+    assert run(marked).returncode == 0
+    cfd = cfdem_case(tmp_path / "cut")
+    stopped = subprocess.run([sys.executable, "-c", STOPPER, "5003", "SIGTERM", "run", str(cfd)], capture_output=True,
+                             text=True, cwd=ROOT, timeout=600)
+    assert stopped.returncode == 143, stopped.stdout[-3000:] + stopped.stderr[-3000:]
+    assert "checkpoint at t = 0.051 s (step 5100)" in stopped.stdout
+    r = run(cfd, "--restart")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "restarted in this run, 4900 steps to go" in r.stdout
+
+    def results(case):
+        out = case / "output"
+        files = ["history.csv", "summary.json"] + sorted(str(p.relative_to(out)) for p in (out / "vtk").rglob("*")
+                                                          if p.is_file())
+        return {f: (out / f).read_bytes() for f in files}
+
+    got, want = results(cfd), results(marked)
+    assert got.keys() == want.keys() and len(got) > 3
+    assert {f: got[f] == want[f] for f in got} == dict.fromkeys(got, True)
+    after = velocities(marked)
+    after = after[after[:, 0] > 0.051 + 1e-9]
+    assert np.array_equal(velocities(cfd), after)

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import STOPPER
 
 pytestmark = [pytest.mark.engines,
               pytest.mark.skipif(shutil.which("mpirun") is None, reason="no mpirun: tools/setup.sh --engines")]
@@ -72,21 +73,6 @@ def test_granular_gas_on_two_ranks(tmp_path):
     assert len(keys) == len(rows) == parallel["collisions"]        # each collision once, not once per rank
 
 
-STOPPER = """
-import os, signal, sys
-import pyhost.commands.run as r
-from pyhost.cli import main
-at = int(sys.argv[1])
-class Stopping:
-    def __init__(self, dem): self.dem = dem
-    def run(self, n):
-        self.dem.run(n)
-        if self.dem.step >= at: os.kill(os.getpid(), signal.SIGKILL)
-    def __getattr__(self, name): return getattr(self.dem, name)
-simulate = r.simulate
-r.simulate = lambda *a, **k: simulate(*a, wrap=Stopping, **k)
-sys.exit(main(sys.argv[2:]))
-"""
 
 
 def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
@@ -98,7 +84,7 @@ def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
     (case / "case.toml").write_text((case / "case.toml").read_text() + "\ncheckpoint = 0.004\npictures = false\n")
     whole = run(case, tmp_path / "whole", 2, "--test")
     mpirun = ["mpirun", "--oversubscribe", "-np", "2", sys.executable]
-    cut = subprocess.run(mpirun + ["-c", STOPPER, "6003", "run", str(case), "--test", "--out", str(tmp_path / "cut")],
+    cut = subprocess.run(mpirun + ["-c", STOPPER, "6003", "SIGKILL", "run", str(case), "--test", "--out", str(tmp_path / "cut")],
                          capture_output=True, text=True, env=ENV, timeout=600)
     assert cut.returncode != 0 and not (tmp_path / "cut" / "summary.json").exists()
     assert (tmp_path / "cut" / "checkpoint" / "manifest.json").is_file()
@@ -131,12 +117,42 @@ def test_serial_checkpoint_continues_on_two_ranks(tmp_path):
     shutil.copytree(CASES / "hot-cold-box", case, ignore=shutil.ignore_patterns("output", "log.*"))
     (case / "case.toml").write_text((case / "case.toml").read_text() + "\ncheckpoint = 0.004\npictures = false\n")
     whole = run(case, tmp_path / "whole", 1, "--test")
-    cut = subprocess.run([sys.executable, "-c", STOPPER, "6003", "run", str(case), "--test", "--out",
+    cut = subprocess.run([sys.executable, "-c", STOPPER, "6003", "SIGKILL", "run", str(case), "--test", "--out",
                           str(tmp_path / "cut")], capture_output=True, text=True, env=ENV, timeout=600)
     assert cut.returncode == -9 and (tmp_path / "cut" / "checkpoint" / "manifest.json").is_file()
     restarted = run(case, tmp_path / "cut", 2, "--test", "--restart")
     assert grid(tmp_path / "cut") not in (None, "1 by 1 by 1")
     assert_continued(restarted, whole)
+
+
+def test_script_on_two_ranks_stopped_while_pouring_restarts_bit_for_bit(tmp_path):
+    """cases/silo-heat --test (a user's script: insertion, an STL tube, a shaken plate) on two
+    ranks with a checkpoint every 6005 steps, stopped by SIGTERM at step 6003 and restarted on
+    two ranks: byte for byte the two-rank run never stopped, insertions included (each rank's
+    random generators are put back). The same checkpoint continued on one rank completes."""
+    runs = {}
+    for name in ("whole", "cut"):
+        runs[name] = tmp_path / name / "silo-heat"
+        shutil.copytree(CASES / "silo-heat", runs[name], ignore=shutil.ignore_patterns("output", "post"))
+        toml = runs[name] / "case.toml"
+        toml.write_text(toml.read_text() + "pictures = false\ncheckpoint = 0.030025\n")
+    whole = run(runs["whole"], tmp_path / "whole-out", 2, "--test")
+    assert grid(tmp_path / "whole-out") == "1 by 1 by 2"
+    out = tmp_path / "out"
+    cut = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", sys.executable, "-c", STOPPER, "6003", "SIGTERM",
+                          "run", str(runs["cut"]), "--test", "--out", str(out)], capture_output=True, text=True,
+                         env=ENV, timeout=600)
+    assert cut.returncode == 143, cut.stdout[-2000:] + cut.stderr[-2000:]
+    shutil.copytree(out, tmp_path / "out1")
+    restarted = run(runs["cut"], out, 2, "--test", "--restart")
+    assert restarted == whole
+    for name in ("collisions.csv", "history.csv"):
+        assert (out / name).read_bytes() == (tmp_path / "whole-out" / name).read_bytes(), name
+    serial = run(runs["cut"], tmp_path / "out1", 1, "--test", "--restart")
+    assert serial["status"] == "completed" and serial["inserted"] == 900 and serial["steps"] == whole["steps"]
+    # measured 5.4e-12 (2e-16 on the same number of ranks; cause not found): the issue asks 1e-9
+    assert abs(serial["energy_balance_error"]) < 1e-10
+    assert serial["collisions"] == pytest.approx(whole["collisions"], rel=0.1)
 
 
 def test_bad_scene_under_mpirun_exits_2_without_hanging(tmp_path):
