@@ -92,13 +92,15 @@ def temperature_difference(T, i, j, T_wall=None):
     return T[i] - T_j
 
 
-def exchange_heat(T, C, i, j, G, T_wall=None):
+def exchange_heat(T, C, i, j, G, T_wall=None, shift=None):
     """Move heat between bodies, one collision after the other, with the temperatures of that
     moment: q = G (T_i - T_j) [J] from i to j, G [J/K] the collision's conductance-time
     (the plugin's Q per kelvin: Q is linear in dT, eqs. 2-3).
 
     T [K] and C = m c [J/K] are per particle; j >= WALL_BASE is wall j - WALL_BASE, with
-    temperature T_wall[wall] (None or NaN: adiabatic, no exchange). No collision carries more
+    temperature T_wall[wall] (None or NaN: adiabatic, no exchange). ``shift`` [K] per collision,
+    if given, is added to its T_i - T_j (temperatures that changed since the collision by what
+    it does not stand for: pyhost.loop's contact events). No collision carries more
     heat than would equalise the two temperatures: a G above C_i C_j/(C_i + C_j) (C_i for a
     wall) is capped there. Returns the heat moved per collision [J], the number capped, and
     the heat that entered the particles from walls [J]; sum(C T) changes by exactly that.
@@ -127,7 +129,7 @@ def exchange_heat(T, C, i, j, G, T_wall=None):
         now = first.reshape(-1, 2).all(axis=1)
         k = left[now]
         a, b, pair = i[k], j[k], ~wall[k]
-        q = g[k] * (T[a] - np.where(pair, T[np.where(pair, b, a)], tw[k]))
+        q = g[k] * (T[a] - np.where(pair, T[np.where(pair, b, a)], tw[k]) + (0.0 if shift is None else shift[k]))
         T[a] -= q / C[a]
         T[b[pair]] += q[pair] / C[b[pair]]
         moved[k] = q

@@ -141,6 +141,7 @@ class Coupling:
         self.fluid_force = (np.zeros(0, np.int64), np.zeros((0, 3)))   # ids and force [N] of the last coupling
         self.progress = Progress(end or math.inf, progress_every)
         self.events = dem.events is not None     # contacts recorded inside LIGGGHTS (else sampled)
+        self.t_coll_of = {}                      # (key, begin step) -> t_coll [s] of pair collisions under heat/gran
         sampled = self.effects["contact_extraction"] and (not self.events or dem.sampled_walls())
         self.every = dict(sample=scene.time.sample_every if sampled else 0,
                           harvest=HARVEST_EVERY if self.events else 0,
@@ -213,7 +214,7 @@ class Coupling:
                 atoms = self.dem.atoms(self.heat)
                 self.track_particles(atoms)
                 if self.events:
-                    self.harvest(atoms)
+                    self.harvest(atoms, final=bool(due["checkpoint"]))
                 if due["sample"]:
                     self.sample_contacts(atoms)
                 if self.keep_all is not None:
@@ -331,9 +332,18 @@ class Coupling:
         mat = self.materials_of(atoms.type)
         C = atoms.mass * self.capacity[mat]
         new = ~self.seen[ids]
+        T_entry = atoms.T[new]                 # the heat content each new atom came in with
+        if self.dem.events is not None and self.dem.events.window:
+            # under heat/gran an atom seen some steps after its insertion may have been conducted
+            # to since: the recorder noted its Temp at its first step, which is what came in
+            came, T_came = self.dem.events.appeared()
+            T_first = np.full(len(self.seen), np.nan)
+            T_first[came[came < len(self.seen)]] = T_came[came < len(self.seen)]
+            T_entry = np.where(np.isnan(T_first[ids[new]]), T_entry, T_first[ids[new]])
         if new.any():
             T_set = self.initial_T(atoms, new)
-            atoms.T[new] = np.where(np.isnan(T_set), atoms.T[new], T_set)
+            atoms.T[new] += np.where(np.isnan(T_set), 0.0, T_set - T_entry)    # what it was conducted kept
+            T_entry = np.where(np.isnan(T_set), T_entry, T_set)
             cold = new & ~(atoms.T > 0)
             if cold.any():
                 k = np.flatnonzero(cold)[0]
@@ -344,7 +354,7 @@ class Coupling:
             if self.scene.scripted:
                 self.check_densities(atoms, new, mat)
             self.totals["inserted"] += int(new.sum())
-            self.totals["energy_in"] += float(np.sum(C[new] * atoms.T[new]))
+            self.totals["energy_in"] += float(np.sum(C[new] * T_entry))
         old = ~new & (self.M_by_id[ids] > 0)
         dm = atoms.mass[old] - self.M_by_id[ids[old]]
         if dm.any():
@@ -464,19 +474,28 @@ class Coupling:
         return (wall, jl, mat, typ, np.where(wall, np.inf, atoms.radius[jj]),
                 np.where(wall, np.inf, atoms.mass[jj]))
 
-    def harvest(self, atoms) -> None:
+    def harvest(self, atoms, final: bool = False) -> None:
         """The contact events recorded inside LIGGGHTS since the last harvest: each begun
         contact is a collision, at its impact speed as recorded at first touch, its heat moved
-        now in the order the collisions happened. Nothing else changes a temperature between
-        two harvests (they come at every fluid exchange, frame and sample), so the heat is what
-        it would be if moved at each collision's own step. A collision whose particle left the
-        simulation before the harvest (deleted, out of the box) is counted apart
-        (collisions_of_departed) and moves no heat: its heat content left at its last sample;
-        so is one that began with no approach speed (contacts_without_impact)."""
+        now in the order the collisions happened. Without a fix heat/gran nothing else changes
+        a temperature between two harvests (they come at every fluid exchange, frame and
+        sample), so the heat is what it would be if moved at each collision's own step; with
+        one, each collision takes the temperature difference it began with (the recorder notes
+        the two temperatures at its first step), and what heat/gran conducted through each new
+        contact during the collision's model time is taken back (``take_back_heat_gran``;
+        ``final``: also for contacts younger than its window, at a checkpoint or the end). A
+        collision whose particle left the simulation before the harvest (deleted, out of the
+        box) is counted apart (collisions_of_departed) and moves no heat: its heat content left
+        at its last sample; so is one that began with no approach speed
+        (contacts_without_impact)."""
         ev = self.dem.events.take()
         begin = ev[ev["kind"] == BEGIN]
-        if not len(begin):
-            return
+        if len(begin):
+            self.collide_begun(atoms, begin)
+        if self.dem.events.window:
+            self.take_back_heat_gran(atoms, final)
+
+    def collide_begun(self, atoms, begin) -> None:
         i = atoms.index(begin["i"])
         j_here = np.where(begin["wall"], 0, atoms.index(np.where(begin["wall"], begin["i"], begin["j"])))
         here = (i >= 0) & (j_here >= 0)
@@ -492,7 +511,42 @@ class Coupling:
         # order in memory (a restart or another number of ranks changes it)
         begin = begin[np.lexsort((begin["j"], begin["i"], begin["wall"], begin["step"]))]
         if len(begin):
-            self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["n"], begin["step"] * self.dem.dt)
+            at = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["n"], begin["step"] * self.dem.dt,
+                              T_begin=begin["T"])
+            if self.dem.events.window:          # each pair collision's model time, until its flux history comes
+                pair = ~begin["wall"]
+                keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
+                self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), at[pair, 1].tolist()))
+
+    def take_back_heat_gran(self, atoms, final: bool) -> None:
+        """What the script's fix heat/gran conducted through each new pair contact during the
+        collision's model duration t_coll, taken back (the collision heat stands for that time):
+        from the recorder's flux history of the contact, step m from the begin carrying flux f_m
+        [W] over dt, Q = dt sum_m f_m clip(t_coll / dt - m, 0, 1) [J] into the smaller id. Exact
+        per step, where the samples took the flux at each sample over the sample interval."""
+        i, j, start, filled, flux = self.dem.events.histories(all=final)
+        if not len(i):
+            return
+        keys = contact_keys(i, j).tolist()
+        t_coll = np.array([self.t_coll_of.pop(k, np.nan) for k in zip(keys, start.tolist())])
+        if final:                                           # every history is in: what is left has none
+            self.t_coll_of = {}
+        if final:
+            self.t_coll_of = {}
+        dt, window = self.dem.dt, flux.shape[1]
+        steps = t_coll / dt
+        cut = np.isfinite(steps) & (steps > window) & (filled == window)
+        if cut.any():
+            self.totals["heat_gran_undo_cut"] = self.totals.get("heat_gran_undo_cut", 0) + int(cut.sum())
+        share = np.clip(np.nan_to_num(steps)[:, None] - np.arange(window), 0.0, 1.0)
+        share[np.arange(window) >= filled[:, None]] = 0.0
+        q = dt * np.sum(flux * share, axis=1)              # heat heat/gran moved into i [J]
+        a, b = atoms.index(i), atoms.index(j)
+        ok = np.isfinite(t_coll) & (a >= 0) & (b >= 0) & (q != 0)
+        a, b, q = a[ok], b[ok], q[ok]
+        np.subtract.at(atoms.T, a, q / self.C[a])
+        np.add.at(atoms.T, b, q / self.C[b])
+        self.totals["heat_gran_undone"] += float(np.abs(q).sum())
 
     def start_collisions(self, atoms, c, keys, rows) -> None:
         i = atoms.index(c.i[rows])
@@ -514,11 +568,13 @@ class Coupling:
         at = self.collide(atoms, c.i[rows], c.j[rows], v0, c.normal[rows], np.full(len(rows), self.t))
         self.info[rows] = at
 
-    def collide(self, atoms, ids_i, j, v0, normal, time) -> np.ndarray:
+    def collide(self, atoms, ids_i, j, v0, normal, time, T_begin=None) -> np.ndarray:
         """Collisions of particles ``ids_i`` with partners ``j`` (ids, or WALL_BASE + wall) at
         impact speeds v0 [m/s] with unit normals (j to i), begun at ``time`` [s]: the plugin's
         heat moved in this order, the totals and the collision log. Returns their OPEN_COLUMNS
-        rows."""
+        rows. ``T_begin`` (n, 2) [K]: the two temperatures when each began (NaN: as now), where
+        something else (a fix heat/gran) changed them since: each collision's temperature
+        difference is the one it began with, plus what earlier collisions of this batch moved."""
         i = atoms.index(ids_i)
         wall, jl, mj, _, R_j, _ = self.partners(atoms, i, j)
         mi, R_i = self.materials_of(atoms.type[i]), atoms.radius[i]
@@ -528,14 +584,18 @@ class Coupling:
         moved = e = t_coll = np.zeros(len(rows))
         side = {}
         if self.heat:
+            shift = None
+            if T_begin is not None:         # (T_i - T_j) then minus now, before this batch
+                drift = T_begin - np.column_stack([atoms.T[i], np.where(wall, np.nan, atoms.T[np.where(wall, i, jl)])])
+                shift = np.nan_to_num(drift[:, 0]) - np.where(wall, 0.0, np.nan_to_num(drift[:, 1]))
             args = (self.scene.effects.heat_path, self.materials, mi, mj, R_i, R_j, v0, np.ones(len(rows)))
             G, e, t_coll, flagged = evaluate_flagged(model, *args)              # Q per kelvin [J/K]
             if flagged.any():
                 self.flag_outside_range(flagged, v0)
             if len(models) > 1:         # side columns: the same collisions at the same dT, nothing moved
-                dT = temperature_difference(atoms.T, i, jl, self.T_wall)
+                dT = temperature_difference(atoms.T, i, jl, self.T_wall) + (0.0 if shift is None else shift)
                 side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}
-            moved, capped, from_walls = exchange_heat(atoms.T, self.C, i, jl, G, self.T_wall)
+            moved, capped, from_walls = exchange_heat(atoms.T, self.C, i, jl, G, self.T_wall, shift)
             self.totals["capped"] += capped
             self.totals["heat_from_walls"] += from_walls
             self.totals["heat_moved"] += float(np.abs(moved[~wall]).sum())
@@ -688,17 +748,18 @@ class Coupling:
     def flush_events(self) -> None:
         """The contact events recorded since the last harvest, taken now (a run stopped
         between harvests: its checkpoint and summary hold every collision)."""
-        if self.events and self.ready and self.dem.events.waiting:
+        if self.events and self.ready and (self.dem.events.waiting or self.dem.events.window):
             atoms = self.dem.atoms(self.heat)
             self.track_particles(atoms)
-            self.harvest(atoms)
+            self.harvest(atoms, final=True)
 
     def finish(self, status: str = "completed") -> dict:
-        if status != "completed":
-            try:
-                self.flush_events()
-            except Exception as err:          # the error that stopped the run is the one to report
-                print(f"warning: the collisions since the last harvest are not in the log ({type(err).__name__}: {err})")
+        try:                                  # (completed: heat/gran's flux histories still filling)
+            self.flush_events()
+        except Exception as err:              # the error that stopped the run is the one to report
+            if status == "completed":
+                raise
+            print(f"warning: the collisions since the last harvest are not in the log ({type(err).__name__}: {err})")
         for series in (self.frames, self.fluid_frames):
             if series is not None:
                 series.flush()

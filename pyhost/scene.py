@@ -231,10 +231,11 @@ class Time:
     contacts: str = spec("in:events,samples", "events",
                          "how collisions are found: 'events', recorded inside LIGGGHTS at every step (the "
                          "impact speed as it is at first touch, no collision missed; serial runs without "
-                         "restitution feedback or fix heat/gran, else samples are used), or 'samples' of "
-                         "LIGGGHTS' contact lists every sample_every steps")
+                         "restitution feedback, else samples are used), or 'samples' of LIGGGHTS' contact "
+                         "lists every sample_every steps")
     sample_every: int = spec(">0", 1, "DEM steps between contact samples (with contact events: of the mesh "
-                                      "and cylinder walls only; 10 misses 6 % of chute_wear's wall contacts)")
+                                      "walls the recorder cannot take only; 10 misses 6 % of chute_wear's wall "
+                                      "contacts)")
     couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
 

@@ -124,6 +124,16 @@ class Table:
         return out
 
 
+@lru_cache(maxsize=1)
+def source_digest(root: Path = Path(__file__).parent) -> str:
+    """SHA-256 of every Python file of the heat plugin (the models in models/ included), with
+    their paths: the tables depend on all of them, so an edited file gives a new cache key."""
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
 @lru_cache(maxsize=32)
 def table(model: str, b1: float, b2: float, c: float, spacing: float | None = None) -> Table:
     """The table of ``model`` for (b1, b2, c): from memory, else from the disk cache
@@ -132,10 +142,8 @@ def table(model: str, b1: float, b2: float, c: float, spacing: float | None = No
     a checksum beside each table catches a damaged file, which is rebuilt with a CacheWarning.
     ``spacing`` other than None (the default H / H_SMOOTH) builds a table of that node
     spacing, cached under its own key."""
-    sources = b"".join((Path(__file__).parent / f).read_bytes()
-                       for f in ("compression.py", "recovery.py", "exact.py", "fast.py"))
     ident = (model, b1, b2, c) if spacing is None else (model, b1, b2, c, float(spacing))
-    key = hashlib.sha256(repr(ident).encode() + sources).hexdigest()[:16]
+    key = hashlib.sha256(repr(ident).encode() + source_digest().encode()).hexdigest()[:16]
     path = _cache_dir() / f"table-{model}-{key}.npy"
     check = path.with_suffix(".sha256")
     tab = Table.__new__(Table)

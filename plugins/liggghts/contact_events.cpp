@@ -12,6 +12,13 @@
 // contact gone is an END event with its duration in steps. The host takes the events in
 // batches (collheat_events_take). The fix adds no force: the callback zeroes its array.
 //
+// With a script's fix heat/gran (collheat_events_conduction), each new pair contact also keeps
+// the flux heat/gran conducts through it at each of its first `window` steps, computed as
+// FixHeatGranCond::post_force_eval does (flux into i = (T_j - T_i) 4 k_i k_j / (k_i + k_j)
+// sqrt(A), A from the overlap, area-corrected, or constant, or projected): the host takes back
+// what heat/gran moved during the collision's model time (pyhost.loop.Coupling.harvest). A
+// history is handed over once full, or when its contact ends (collheat_events_histories).
+//
 // Keys as pyhost.collisions.contact_keys: (smaller id << 31) | larger id, a wall being
 // WALL_BASE + its index (> every particle id). Under MPI a pair is recorded by the rank that
 // owns the atom of the smaller id (a wall contact by the atom's owner).
@@ -33,13 +40,26 @@
 #include "fix_mesh_surface.h"
 #include "fix_neighlist_mesh.h"
 #include "tri_mesh.h"
+#include "fix_property_atom.h"
+#define protected public
+#include "fix_heat_gran_conduction.h"
+#undef protected
 
 using namespace LAMMPS_NS;
 
 namespace {
 
 enum Kind { PAIR_BEGIN = 0, PAIR_END = 1, WALL_BEGIN = 2, WALL_END = 3 };
-constexpr int ROW = 9;  // kind, step, i, j, vn [m/s], nx, ny, nz, duration [steps]
+constexpr int ROW = 11; // kind, step, i, j, vn [m/s], nx, ny, nz, duration [steps], T_i, T_j [K] at the begin
+constexpr int HEAD = 4; // a flux history: i, j (ids, i < j), step of the begin, steps kept; then the fluxes
+enum Area { OVERLAP = 0, CONSTANT = 1, PROJECTION = 2 };   // FixHeatGranCond's contact area modes
+
+struct History {                               // a new pair contact's heat/gran flux [W] into i, per step
+    uint64_t key;
+    bigint start;
+    int filled;
+    std::vector<double> flux;
+};
 
 struct Recorder {
     LAMMPS *lmp;
@@ -49,11 +69,20 @@ struct Recorder {
     std::vector<int> axis;                     // primitive planes: axis (0, 1, 2), position [m],
     std::vector<double> position;              // and the partner code the host gives them
     std::vector<double> code;
+    std::vector<int> cyl_axis;                 // primitive cylinders: axis, radius [m], centre in the
+    std::vector<double> cyl_radius, cyl_c1, cyl_c2, cyl_code;   // two other coordinates [m], code
     std::vector<FixMeshSurface *> meshes;       // mesh walls: the fix mesh/surface and the code
     std::vector<double> mesh_code;             // of its contacts (one per particle and mesh: the deepest)
     std::vector<double> depth, normal;         // per mesh and local atom, this call: overlap [m] and normal
     bool new_planes = false;                   // planes given since the last call: what touches them is open
     long long begun = 0, ended = 0;
+    FixHeatGranCond *conduction = nullptr;     // a script's fix heat/gran, or none
+    int window = 0;                            // steps of flux kept per new pair contact
+    std::vector<History> histories;            // in use or free (free: start < 0)
+    std::vector<int> free_histories;
+    std::vector<double> done;                  // histories handed over: HEAD + window doubles each
+    tagint max_tag = -1;                       // with heat/gran: the largest id seen, and each new
+    std::vector<double> appeared;              // atom's id and Temp at its first step (before heat/gran moves any)
 
     // The state of the contacts, laid out like the neighbour list (one slot per entry, in
     // the order of ilist and each atom's neighbours) and, for the planes, like the local
@@ -61,33 +90,111 @@ struct Recorder {
     // sorts, exchanges, inserts and deletes atoms only before a build), so between builds a
     // step costs a distance test per neighbour and no lookup. At a build, the open contacts
     // are carried over by key.
-    bigint layout = -1;                        // neighbor->ncalls of the layout
+    bigint layout = -1;                        // neighbor->ncalls of the layout,
+    bigint layout_last = -1;                   // neighbor->lastcall (init() starts ncalls again),
+    const NeighList *layout_list = nullptr;    // the list and its atoms
+    int layout_inum = -1;
     size_t planes_laid = 0;                    // planes and local atoms in the layout
     int nlocal_laid = -1;
     std::vector<uint8_t> touch;                // in contact at the last call
     std::vector<bigint> since;                 // step of the first call in contact
     std::vector<uint64_t> key;                 // the contact's key
-    std::unordered_map<uint64_t, bigint> carry;
+    std::vector<int> history;                  // its flux history (index into histories), or -1
+    std::unordered_map<uint64_t, std::pair<bigint, int>> carry;
 
-    void event(int kind, bigint step, double i, double j, double vn, const double *n, double duration)
+    void event(int kind, bigint step, double i, double j, double vn, const double *n, double duration,
+               double Ti = NAN, double Tj = NAN)
     {
-        const double row[ROW] = {double(kind), double(step), i, j, vn, n[0], n[1], n[2], duration};
+        const double row[ROW] = {double(kind), double(step), i, j, vn, n[0], n[1], n[2], duration, Ti, Tj};
         rows.insert(rows.end(), row, row + ROW);
     }
 
-    // Slot k in contact now (its key k_, ids i and j, approach speed vn, normal n).
-    inline void on(size_t k, bigint step, bool rebuilt, int kind, uint64_t k_, double i, double j, double vn,
-                   const double *n, bool quiet = false)
+    // Slot k in contact now (its key k_, ids i and j, local atoms li and lj (-1: a wall),
+    // approach speed vn, normal n). With heat/gran, a BEGIN carries the two temperatures of
+    // that step: heat/gran changes them before the host takes the event.
+    inline void on(size_t k, bigint step, bool rebuilt, int kind, uint64_t k_, double i, double j, int li, int lj,
+                   double vn, const double *n, bool quiet = false)
     {
         if (touch[k] && !rebuilt) return;
         touch[k] = 1;
         key[k] = k_;
+        history[k] = -1;
         if (rebuilt) {
             auto it = carry.find(k_);
-            if (it != carry.end()) { since[k] = it->second; carry.erase(it); return; }
+            if (it != carry.end()) {
+                since[k] = it->second.first;
+                history[k] = it->second.second;
+                carry.erase(it);
+                return;
+            }
         }
         since[k] = step;
-        if (primed && !quiet) { event(kind, step, i, j, vn, n, 0.0); ++begun; }
+        if (primed && !quiet) {
+            const double *T = conduction ? conduction->Temp : nullptr;
+            event(kind, step, i, j, vn, n, 0.0, T ? T[li] : NAN, T && lj >= 0 ? T[lj] : NAN);
+            ++begun;
+            if (conduction && kind == PAIR_BEGIN) history[k] = open_history(k_, step);
+        }
+    }
+
+    int open_history(uint64_t k_, bigint step)
+    {
+        int h;
+        if (free_histories.empty()) { h = int(histories.size()); histories.push_back(History()); }
+        else { h = free_histories.back(); free_histories.pop_back(); }
+        History &y = histories[h];
+        y.key = k_;
+        y.start = step;
+        y.filled = 0;
+        y.flux.assign(window, 0.0);
+        return h;
+    }
+
+    // Hand history h over (full, or its contact ended) and free it.
+    void close_history(int h)
+    {
+        History &y = histories[h];
+        const double head[HEAD] = {double(y.key >> 31), double(y.key & ((uint64_t(1) << 31) - 1)), double(y.start),
+                                   double(y.filled)};
+        done.insert(done.end(), head, head + HEAD);
+        done.insert(done.end(), y.flux.begin(), y.flux.end());
+        y.start = -1;
+        free_histories.push_back(h);
+    }
+
+    // heat/gran's flux [W] into local or ghost atom i from j now (FixHeatGranCond::post_force_eval).
+    double heat_gran_flux(int i, int j, double rsq) const
+    {
+        const double *r = lmp->atom->radius;
+        const int *type = lmp->atom->type;
+        const double radi = r[i], radj = r[j], radsum = radi + radj;
+        double area;
+        if (conduction->area_calculation_mode_ == CONSTANT)
+            area = conduction->fixed_contact_area_;
+        else if (conduction->area_calculation_mode_ == PROJECTION)
+            area = M_PI * std::max(radi, radj) * std::max(radi, radj);
+        else {
+            double dist = std::sqrt(rsq);
+            if (conduction->area_correction_flag_)
+                dist = radsum - (radsum - dist) * conduction->deltan_ratio_[type[i] - 1][type[j] - 1];
+            area = -M_PI / 4 * ((dist - radi - radj) * (dist + radi - radj) * (dist - radi + radj) * (dist + radi + radj)) /
+                   (dist * dist);
+        }
+        const double ki = conduction->conductivity_[type[i] - 1], kj = conduction->conductivity_[type[j] - 1];
+        const double hc = (ki > 0 && kj > 0) ? 4. * ki * kj / (ki + kj) * std::sqrt(area) : 0.0;
+        return (conduction->Temp[j] - conduction->Temp[i]) * hc;
+    }
+
+    // Slot k (atoms i, j in contact now, |x_i - x_j|^2 = rsq): its flux at this step into the smaller id.
+    void conduct(size_t k, int i, int j, double rsq, bigint step)
+    {
+        History &y = histories[history[k]];
+        const bigint age = step - y.start;
+        if (age < 0 || age >= window) return;
+        const double into_i = heat_gran_flux(i, j, rsq);
+        y.flux[age] = lmp->atom->tag[i] < lmp->atom->tag[j] ? into_i : -into_i;
+        y.filled = int(age) + 1;
+        if (y.filled == window) { close_history(history[k]); history[k] = -1; }
     }
 
     // Slot k not in contact now: an END if it was (between builds; at a build, what is left
@@ -96,7 +203,10 @@ struct Recorder {
     {
         if (!touch[k]) return;
         touch[k] = 0;
-        if (!rebuilt) end(key[k], since[k], step);
+        if (!rebuilt) {
+            end(key[k], since[k], step);
+            if (history[k] >= 0) { close_history(history[k]); history[k] = -1; }
+        }
     }
 
     void end(uint64_t k_, bigint start, bigint step)
@@ -120,8 +230,12 @@ struct Recorder {
         NeighList *list = pair ? pair->list : nullptr;
         const bool have_list = list && list->ilist;
         // a new layout at each neighbour build (or new planes): the slots counted then only
-        const size_t walls = axis.size() + meshes.size();
-        const bool rebuilt = lmp->neighbor->ncalls != layout || walls != planes_laid || nlocal != nlocal_laid;
+        const size_t walls = axis.size() + cyl_axis.size() + meshes.size();
+        // (a run's set-up calls Neighbor::init, which counts builds from 0 again: the step of
+        // the last build and the list itself tell a build that ncalls alone misses)
+        const Neighbor *nb = lmp->neighbor;
+        const bool rebuilt = nb->ncalls != layout || nb->lastcall != layout_last || walls != planes_laid ||
+                             nlocal != nlocal_laid || (have_list && (list != layout_list || list->inum != layout_inum));
         if (rebuilt) {                         // the open contacts, by key, into the new layout
             size_t slots = 0;
             if (have_list)
@@ -131,13 +245,27 @@ struct Recorder {
             nlocal_laid = nlocal;
             carry.clear();
             for (size_t k = 0; k < touch.size(); ++k)
-                if (touch[k]) carry.emplace(key[k], since[k]);
+                if (touch[k]) carry.emplace(key[k], std::make_pair(since[k], history[k]));
             touch.assign(slots, 0);
             since.resize(slots);
             key.resize(slots);
-            layout = lmp->neighbor->ncalls;
+            history.assign(slots, -1);
+            layout = nb->ncalls;
+            layout_last = nb->lastcall;
+            layout_list = have_list ? list : nullptr;
+            layout_inum = have_list ? list->inum : -1;
         }
         size_t k = 0;
+        if (conduction) {
+            conduction->updatePtrs();                       // its Temp, after any insertion
+            tagint top = max_tag;
+            for (int i = 0; i < nlocal; ++i)
+                if (tag[i] > max_tag) {
+                    if (primed && max_tag >= 0) { appeared.push_back(double(tag[i])); appeared.push_back(conduction->Temp[i]); }
+                    top = std::max(top, tag[i]);
+                }
+            max_tag = top;
+        }
         if (have_list) {
             NeighList *hist = pair->listgranhistory;        // LIGGGHTS' own contact flags, if it keeps them
             const bool flags = hist && hist->firstneigh && !rebuilt;
@@ -156,16 +284,18 @@ struct Recorder {
                     // recorded once: a pair of two local atoms as listed; a pair with a ghost (an
                     // atom of another rank, or a periodic image) by the owner of the smaller id
                     if (rsq >= radsum * radsum || (j >= nlocal && tag[i] > tag[j])) { off(k, step, rebuilt); continue; }
-                    if (touch[k] && !rebuilt) continue;
-                    const bool i_first = tag[i] < tag[j];
-                    const int lo = i_first ? i : j, hi = i_first ? j : i;
-                    const double dist = std::sqrt(rsq);
-                    const double s = (i_first ? 1.0 : -1.0) / (dist > 0 ? dist : 1.0);
-                    const double n[3] = {d[0] * s, d[1] * s, d[2] * s};       // from hi to lo
-                    const double vn = -((v[lo][0] - v[hi][0]) * n[0] + (v[lo][1] - v[hi][1]) * n[1] +
-                                        (v[lo][2] - v[hi][2]) * n[2]);
-                    on(k, step, rebuilt, PAIR_BEGIN, (uint64_t(tag[lo]) << 31) | uint64_t(tag[hi]),
-                       tag[lo], tag[hi], vn, n);
+                    if (!touch[k] || rebuilt) {
+                        const bool i_first = tag[i] < tag[j];
+                        const int lo = i_first ? i : j, hi = i_first ? j : i;
+                        const double dist = std::sqrt(rsq);
+                        const double s = (i_first ? 1.0 : -1.0) / (dist > 0 ? dist : 1.0);
+                        const double n[3] = {d[0] * s, d[1] * s, d[2] * s};       // from hi to lo
+                        const double vn = -((v[lo][0] - v[hi][0]) * n[0] + (v[lo][1] - v[hi][1]) * n[1] +
+                                            (v[lo][2] - v[hi][2]) * n[2]);
+                        on(k, step, rebuilt, PAIR_BEGIN, (uint64_t(tag[lo]) << 31) | uint64_t(tag[hi]),
+                           tag[lo], tag[hi], lo, hi, vn, n);
+                    }
+                    if (history[k] >= 0) conduct(k, i, j, rsq, step);
                 }
             }
         }
@@ -177,8 +307,27 @@ struct Recorder {
                 if (touch[k] && !rebuilt) continue;
                 double n[3] = {0, 0, 0};
                 n[a] = gap >= 0 ? 1.0 : -1.0;                                  // from the wall to the particle
-                on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(code[w]), tag[i], code[w],
+                on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(code[w]), tag[i], code[w], i, -1,
                    -v[i][a] * n[a], n, new_planes);
+            }
+        }
+        // cylinders (particles inside or outside): overlap = radius - distance to the surface,
+        // the normal from the wall to the particle, as pyhost.engines.dem._primitive_contacts
+        for (size_t w = 0; w < cyl_axis.size(); ++w) {
+            const int a = cyl_axis[w], b = (a + 1) % 3, c = (a + 2) % 3;
+            const int lo = std::min(b, c), hi = std::max(b, c);          // the other axes in order (c1, c2)
+            const double R = cyl_radius[w];
+            for (int i = 0; i < nlocal; ++i, ++k) {
+                const double d1 = x[i][lo] - cyl_c1[w], d2 = x[i][hi] - cyl_c2[w];
+                const double dist = std::sqrt(d1 * d1 + d2 * d2);
+                const bool inside = dist < R;
+                if (r[i] - (inside ? R - dist : dist - R) <= 0) { off(k, step, rebuilt); continue; }
+                if (touch[k] && !rebuilt) continue;
+                const double s = (inside ? -1.0 : 1.0) / (dist > 0 ? dist : 1.0);
+                double n[3] = {0, 0, 0};
+                n[lo] = d1 * s; n[hi] = d2 * s;
+                on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(cyl_code[w]), tag[i], cyl_code[w],
+                   i, -1, -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]), n, new_planes);
             }
         }
         // mesh walls: LIGGGHTS' own candidates of each triangle and its own contact test
@@ -219,11 +368,14 @@ struct Recorder {
                 const double *n = &normal[3 * (m * nlocal + i)];
                 const double vn = -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]);   // the wall's own motion left out
                 on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]), tag[i], mesh_code[m],
-                   vn, n, new_planes);
+                   i, -1, vn, n, new_planes);
             }
         }
         if (rebuilt) {                         // contacts of the old layout not found again: ended
-            for (const auto &c : carry) end(c.first, c.second, step);
+            for (const auto &c : carry) {
+                end(c.first, c.second.first, step);
+                if (c.second.second >= 0) close_history(c.second.second);
+            }
             carry.clear();
         }
         primed = true;
@@ -281,6 +433,20 @@ void collheat_events_planes(void *handle, int n, const int *axis, const double *
     rec->new_planes = true;
 }
 
+// The host's primitive cylinders: n of them, each an axis (0, 1, 2), a radius [m], the centre in
+// the two other coordinates (in axis order) [m] and the partner code of its contacts.
+void collheat_events_cylinders(void *handle, int n, const int *axis, const double *radius, const double *c1,
+                               const double *c2, const double *code)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    std::vector<int> a(axis, axis + n);
+    std::vector<double> R(radius, radius + n), x1(c1, c1 + n), x2(c2, c2 + n), k(code, code + n);
+    if (a == rec->cyl_axis && R == rec->cyl_radius && x1 == rec->cyl_c1 && x2 == rec->cyl_c2 && k == rec->cyl_code)
+        return;
+    rec->cyl_axis = a; rec->cyl_radius = R; rec->cyl_c1 = x1; rec->cyl_c2 = x2; rec->cyl_code = k;
+    rec->new_planes = true;
+}
+
 // The host's mesh walls: n `fix mesh/surface` ids and the partner code of each. Returns the
 // number found with a neighbour list (a mesh used by a fix wall/gran), or -1 if one is not.
 int collheat_events_meshes(void *handle, int n, const char **ids, const double *code)
@@ -312,6 +478,56 @@ void collheat_events_sync(void *handle)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
     rec->record(rec->lmp->update->ntimestep);
+}
+
+// Keep heat/gran's flux through each new pair contact for its first `window` steps: `fix_id`
+// is the script's fix heat/gran. Returns 0, or -1 if that fix is not a heat/gran conduction.
+int collheat_events_conduction(void *handle, const char *fix_id, int window)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    const int f = rec->lmp->modify->find_fix(fix_id);
+    if (f < 0 || std::strncmp(rec->lmp->modify->fix[f]->style, "heat/gran", 9) != 0 || window < 1) return -1;
+    rec->conduction = static_cast<FixHeatGranCond *>(rec->lmp->modify->fix[f]);
+    rec->window = window;
+    return 0;
+}
+
+// Flux histories handed over and waiting (HEAD + window doubles each); with `all`, first hand
+// over every history still filling (a stop, a checkpoint: what follows takes none back).
+int collheat_events_histories(void *handle, int all)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    if (all) {
+        for (size_t k = 0; k < rec->history.size(); ++k)
+            if (rec->history[k] >= 0) { rec->close_history(rec->history[k]); rec->history[k] = -1; }
+        for (auto &c : rec->carry)
+            if (c.second.second >= 0) { rec->close_history(c.second.second); c.second.second = -1; }
+    }
+    return rec->window ? int(rec->done.size() / (HEAD + rec->window)) : 0;
+}
+
+// Copy the waiting histories into out (n of them, HEAD + window doubles each) and drop them.
+int collheat_events_take_histories(void *handle, double *out, int n)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    const size_t row = HEAD + rec->window;
+    n = std::min<int>(n, rec->window ? int(rec->done.size() / row) : 0);
+    std::memcpy(out, rec->done.data(), sizeof(double) * row * n);
+    rec->done.erase(rec->done.begin(), rec->done.begin() + row * n);
+    return n;
+}
+
+// Atoms that appeared since the last call (with heat/gran): their number; with out, copy their
+// id and Temp at their first step (2 doubles each, up to n) and forget them.
+int collheat_events_appeared(void *handle, double *out, int n)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    const int have = int(rec->appeared.size() / 2);
+    if (!out) return have;
+    n = std::min(n, have);
+    std::memcpy(out, rec->appeared.data(), sizeof(double) * 2 * n);
+    rec->appeared.erase(rec->appeared.begin(), rec->appeared.begin() + 2 * n);
+    return n;
 }
 
 // Events waiting, open contacts now, and all BEGIN and END events recorded so far.

@@ -27,12 +27,18 @@ import numpy as np
 
 from pyhost.collisions import WALL_BASE
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
-from pyhost.engines.ranks import local_random_states, set_random_states, collective, gather_arrays, local_atoms, local_values, put_by_id, write_local
+from pyhost.engines.ranks import (collective, gather_arrays, local_atoms, local_random_states, local_values, put_by_id,
+                                  set_random_states, write_local)
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 
 FLUID_FIX = "collheat_fluid"
 PAIR_COMPUTE, WALL_COMPUTE = "collheat_pairs", "collheat_walls"
 NEEDED = ("pos", "vel", "id")
+HEAT_GRAN_WINDOW = 200
+"""DEM steps of a fix heat/gran's flux the event recorder keeps per new pair contact: what
+heat/gran moved during a collision's model duration t_coll is taken back from them, so
+t_coll up to this many steps is taken back whole (a longer one: its first 200 steps, counted
+as heat_gran_undo_cut)."""
 
 
 @dataclass(frozen=True)
@@ -186,10 +192,10 @@ class Dem:
 
     def events_possible(self, restitution_feedback: bool) -> bool:
         """Whether the contact events can stand for samples of the pair contacts: serial (each
-        rank's own events are the issue on MPI), no fix heat/gran (its conduction during a
-        collision is taken back from sampled fluxes) and no restitution feedback (imposed at
-        the sample that sees a contact end)."""
-        return self.link is None and not self.info.heat_gran and not restitution_feedback
+        rank's own events are the issue on MPI) and no restitution feedback (imposed at the
+        sample that sees a contact end). A fix heat/gran's conduction during a collision is
+        taken back from the recorder's flux histories (``HEAT_GRAN_WINDOW``)."""
+        return self.link is None and not restitution_feedback
 
     def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
                 events: bool = False) -> list[str]:
@@ -219,6 +225,8 @@ class Dem:
         if events:
             from pyhost.engines.events import ContactEvents
             self.events = ContactEvents(self.lmp)
+            if heat and self.info.heat_gran:
+                self.events.conduction(self.info.heat_gran, HEAT_GRAN_WINDOW)
         for which in ("pair_compute", "wall_compute"):
             found = getattr(self.info, which)
             if found and found[0] not in (PAIR_COMPUTE, WALL_COMPUTE):
@@ -391,21 +399,28 @@ class Dem:
         return fix
 
     def has_heat_flux(self) -> bool:
-        """Whether the pair contact compute has heat/gran's heatFlux column."""
+        """Whether heat/gran's flux through each contact reaches the host: the pair contact
+        compute's heatFlux column, or the event recorder's flux histories."""
+        if self.events is not None:
+            return self.events.window > 0
         return self.info.pair_compute is not None and "heatFlux" in self.info.pair_compute[1]
 
     # -- contacts ---------------------------------------------------------------------
     def sampled_walls(self) -> bool:
-        """Whether some wall's contacts must still be sampled beside the event recorder
-        (cylinders; mesh walls it could not take)."""
-        return any((w.meshes and not self._mesh_events) or (w.primitive is not None and not w.primitive[0].endswith("plane"))
-                   for w in self.info.walls.values())
+        """Whether some wall's contacts must still be sampled beside the event recorder (mesh
+        walls it could not take)."""
+        return any(w.meshes and not self._mesh_events for w in self.info.walls.values())
 
     def event_planes(self, wall_index: dict) -> None:
-        """The primitive plane and mesh walls, for the event recorder, with their contact codes."""
-        planes = [("xyz".index(w.primitive[0][0]), w.primitive[1][0], WALL_BASE + wall_index[fix, 0])
-                  for fix, w in self.info.walls.items() if w.primitive is not None and w.primitive[0].endswith("plane")]
+        """The primitive plane, cylinder and mesh walls, for the event recorder, with their
+        contact codes."""
+        primitive = [(w.primitive, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items()
+                     if w.primitive is not None]
+        planes = [("xyz".index(kind[0]), num[0], code) for (kind, num), code in primitive if kind.endswith("plane")]
         self.events.planes(*(zip(*planes) if planes else ([], [], [])))
+        cylinders = [("xyz".index(kind[0]), *num[:3], code) for (kind, num), code in primitive
+                     if kind.endswith("cylinder")]
+        self.events.cylinders(*(zip(*cylinders) if cylinders else ([], [], [], [], [])))
         meshes = [(mesh, WALL_BASE + wall_index[fix, k]) for fix, w in self.info.walls.items()
                   for k, mesh in enumerate(w.meshes or ())]
         self._mesh_events = self.events.meshes(*(zip(*meshes) if meshes else ([], [])))
@@ -415,13 +430,13 @@ class Dem:
 
     def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:
         """Every contact now (see :class:`Contacts`); with the event recorder, only those it
-        does not record: mesh and cylinder walls. ``wall_index``: host wall index of each
+        does not record: mesh walls without a neighbour list. ``wall_index``: host wall index of each
         (wall/gran fix id, mesh index in the fix); a particle touching several triangles of one
         mesh is one contact (the deepest)."""
         events = self.events is not None
         parts = [] if events else [self._pair_contacts(atoms)]
         for fix, wall in self.info.walls.items():
-            if events and wall.primitive is not None and wall.primitive[0].endswith("plane"):
+            if events and wall.primitive is not None:
                 continue
             if wall.primitive is not None:
                 parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix, 0]))

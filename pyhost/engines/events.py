@@ -8,6 +8,12 @@ begins or ends. ``take()`` hands the events over in a batch, as a numpy structur
 WALL_BASE + wall index for a wall), vn, the approach speed at the first step in contact [m/s]
 (the relative normal velocity before any contact force acted: the impact speed), the unit
 normal n from j to i, and for an END the contact's duration in steps. Units SI.
+
+With a script's fix heat/gran, ``conduction(fix, window)`` has the recorder also keep the flux
+heat/gran conducts through each new pair contact at each of its first ``window`` steps (its
+own formula, in compiled code); ``histories()`` hands them over once full or ended; and each
+BEGIN carries T, the two temperatures [K] at its step (NaN without heat/gran; for a wall, the
+particle's and NaN).
 """
 from __future__ import annotations
 
@@ -16,10 +22,10 @@ import ctypes
 import numpy as np
 
 FIX = "collheat_events"
-ROW = 9
+ROW = 11
 BEGIN, END = 0, 1
 EVENT = np.dtype([("kind", np.int8), ("wall", np.bool_), ("step", np.int64), ("i", np.int64), ("j", np.int64),
-                  ("vn", float), ("n", float, 3), ("duration", np.int64)])
+                  ("vn", float), ("n", float, 3), ("duration", np.int64), ("T", float, 2)])
 
 _c = ctypes
 _vp, _int, _dp = _c.c_void_p, _c.c_int, _c.POINTER(_c.c_double)
@@ -34,7 +40,13 @@ _DECLARATIONS = {
     "collheat_events_total": (_c.c_longlong, [_vp, _int]),
     "collheat_events_take": (_int, [_vp, _dp, _int]),
     "collheat_events_free": (None, [_vp]),
+    "collheat_events_conduction": (_int, [_vp, _c.c_char_p, _int]),
+    "collheat_events_histories": (_int, [_vp, _int]),
+    "collheat_events_take_histories": (_int, [_vp, _dp, _int]),
+    "collheat_events_appeared": (_int, [_vp, _dp, _int]),
+    "collheat_events_cylinders": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp, _dp, _dp]),
 }
+HEAD = 4
 
 
 class ContactEvents:
@@ -52,6 +64,36 @@ class ContactEvents:
         self.handle = h.collheat_events_attach(lmp.ptr, fix.encode())
         if not self.handle:
             raise RuntimeError(f"could not attach the contact event recorder to fix {fix}")
+        self.window = 0
+
+    def conduction(self, fix: str, window: int) -> None:
+        """Keep the flux [W] of ``fix <fix> ... heat/gran`` through each new pair contact at
+        each of its first ``window`` steps."""
+        if self.lmp.helper.collheat_events_conduction(self.handle, fix.encode(), int(window)):
+            raise RuntimeError(f"fix {fix} is not a heat/gran conduction: no flux histories")
+        self.window = int(window)
+
+    def appeared(self) -> tuple:
+        """Atoms that appeared (inserted) since the last call, with heat/gran: ids and Temp [K]
+        at their first step, before heat/gran conducted any heat to them."""
+        h = self.lmp.helper
+        n = h.collheat_events_appeared(self.handle, None, 0) if self.window else 0
+        raw = np.empty((n, 2))
+        if n:
+            raw = raw[:h.collheat_events_appeared(self.handle, raw.ctypes.data_as(_dp), n)]
+        return raw[:, 0].astype(np.int64), raw[:, 1]
+
+    def histories(self, all: bool = False) -> tuple:
+        """The flux histories handed over (with ``all``, also those still filling, which the
+        recorder then drops): i, j (ids, i < j), the step the contact began, the steps kept,
+        and the fluxes [W] into i at each step from the begin, (n, window)."""
+        h = self.lmp.helper
+        n = h.collheat_events_histories(self.handle, int(all)) if self.window else 0
+        raw = np.empty((n, HEAD + self.window))
+        if n:
+            raw = raw[:h.collheat_events_take_histories(self.handle, raw.ctypes.data_as(_dp), n)]
+        ids = raw[:, :3].astype(np.int64)
+        return ids[:, 0], ids[:, 1], ids[:, 2], raw[:, 3].astype(np.int64), raw[:, HEAD:]
 
     def planes(self, axes, positions, codes) -> None:
         """Primitive plane walls: axis (0, 1, 2 for x, y, z), position [m], and the partner
@@ -61,6 +103,14 @@ class ContactEvents:
         codes = np.ascontiguousarray(codes, dtype=float)
         self.lmp.helper.collheat_events_planes(self.handle, len(axes), axes.ctypes.data_as(_c.POINTER(_int)),
                                                positions.ctypes.data_as(_dp), codes.ctypes.data_as(_dp))
+
+    def cylinders(self, axes, radii, c1, c2, codes) -> None:
+        """Primitive cylinder walls: axis (0, 1, 2), radius [m], the centre in the two other
+        coordinates (in axis order) [m], and the partner code of each."""
+        axes = np.ascontiguousarray(axes, dtype=np.intc)
+        arrays = [np.ascontiguousarray(a, dtype=float) for a in (radii, c1, c2, codes)]
+        self.lmp.helper.collheat_events_cylinders(self.handle, len(axes), axes.ctypes.data_as(_c.POINTER(_int)),
+                                                  *(a.ctypes.data_as(_dp) for a in arrays))
 
     def meshes(self, ids, codes) -> bool:
         """Mesh walls: the ``fix mesh/surface`` id and the partner code of each. False (and
@@ -108,6 +158,7 @@ class ContactEvents:
         out["vn"] = raw[:, 4]
         out["n"] = raw[:, 5:8]
         out["duration"] = raw[:, 8]
+        out["T"] = raw[:, 9:11]
         return out
 
     def close(self) -> None:

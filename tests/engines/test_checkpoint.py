@@ -268,16 +268,17 @@ def silo_restart_is_the_marked_run(tmp_path, stop: int, checkpoint: float, every
 
 
 def test_script_stopped_while_shaking_restarts_bit_for_bit(tmp_path):
-    """silo-heat --test (no output.checkpoint) stopped by SIGTERM at step 15003, in its third run
-    (the plate shaken by fix move/mesh since step 14001): a checkpoint at step 15005, then
+    """silo-heat --test (no output.checkpoint) stopped by SIGTERM at step 14503, in its third run
+    (the plate shaken by fix move/mesh since step 14001): a checkpoint at the end of the DEM
+    chunk under way (the contact events are harvested every 1000 steps), step 15000, then
     --restart replays the script's set-up with read_restart in place of create_box, gives the
     plate its motion's time back (LIGGGHTS' restart file does not keep it: without it the plate
-    left its path and the bed had 30 % more collisions) and runs the 995 steps to go. Collisions,
+    left its path and the bed had 30 % more collisions) and runs the 1000 steps to go. Collisions,
     history, summary and the script's own last dump equal byte for byte the run that wrote a
     checkpoint at that step and went on."""
-    stopped, restarted = silo_restart_is_the_marked_run(tmp_path, 15003, checkpoint=0.075025, every=None)
-    assert "checkpoint at t = 0.075025 s (step 15005)" in stopped
-    assert "in.liggghts:102: restarted in this run, 995 steps to go" in restarted
+    stopped, restarted = silo_restart_is_the_marked_run(tmp_path, 14503, checkpoint=0.075, every=None)
+    assert "checkpoint at t = 0.075 s (step 15000)" in stopped
+    assert "in.liggghts:102: restarted in this run, 1000 steps to go" in restarted
 
 
 def test_script_stopped_while_pouring_restarts_bit_for_bit(tmp_path):

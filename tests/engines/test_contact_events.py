@@ -85,6 +85,67 @@ def test_a_sphere_dropped_on_a_plane_begins_at_the_free_fall_speed(tmp_path):
     assert np.allclose(begin[0]["n"], [0, 0, 1])
 
 
+def test_a_sphere_thrown_at_a_cylinder_wall_begins_at_its_radial_speed(tmp_path):
+    """A sphere inside a zcylinder wall (radius 8 mm, axis off the origin), thrown outward along
+    x and y at once: it begins touching the cylinder at the step its surface reaches it, with
+    the approach speed its velocity's radial part, and the normal from the wall to it pointing
+    to the axis."""
+    Rc, cx, cy, v = 0.008, 0.001, -0.0005, (0.3, 0.4)
+    with box(tmp_path) as lg:
+        lg.commands(f"""
+            fix tube all wall/gran model hertz tangential history primitive type 1 zcylinder {Rc} {cx} {cy}
+            create_atoms 1 single {cx} {cy} 0 units box
+            set atom 1 diameter {2 * R} density {RHO} vx {v[0]} vy {v[1]}
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        ev.cylinders([2], [Rc], [cx], [cy], [WALL_BASE + 0])
+        lg.run(30000)
+        got = ev.take()
+    begin = got[got["kind"] == BEGIN]
+    assert len(begin) >= 1 and bool(begin[0]["wall"]) and begin[0]["j"] == WALL_BASE
+    speed = math.hypot(*v)
+    print(f"step {begin[0]['step']}, vn {begin[0]['vn']:.12f} m/s")
+    assert begin[0]["step"] == math.floor((Rc - R) / speed / DT) + 1       # free flight from the axis
+    assert begin[0]["vn"] == pytest.approx(speed, rel=1e-12)              # radial: the whole velocity
+    assert np.allclose(begin[0]["n"], [-v[0] / speed, -v[1] / speed, 0.0], atol=1e-9)
+
+
+def test_heat_gran_flux_histories_equal_liggghts_own_per_contact_flux(tmp_path):
+    """With a fix heat/gran (area correction on), the recorder keeps the flux through each new
+    pair contact at each of its first steps: the head-on pair's history equals, step by step,
+    the heatFlux heat/gran itself summed into atom 1 at that step (its only contact), to
+    1e-12; the begin carries the two temperatures of its step."""
+    V, window = 0.5, 40
+    with box(tmp_path) as lg:
+        head_on(lg, V)
+        lg.commands(f"""
+            fix ym0 all property/global youngsModulusOriginal peratomtype {4 * E}
+            fix k all property/global thermalConductivity peratomtype 20.0
+            fix c all property/global thermalCapacity peratomtype 500.0
+            fix heat all heat/gran initial_temperature 300. area_correction yes
+            run 0
+            set atom 1 property/atom Temp 400.
+        """)
+        ev = ContactEvents(lg)
+        ev.conduction("heat", window)
+        lg.run(1)
+        flux = []
+        for _ in range(1500):
+            lg.run(1)
+            q = lg.property_atom("heatFlux")[np.argsort(lg.atom("id"))]
+            if q[0] != 0:
+                assert q[1] == pytest.approx(-q[0], rel=1e-12)
+                flux.append(q[0])                                   # into atom 1 [W]
+        got = ev.take()
+        i, j, start, filled, history = ev.histories(all=True)
+    begin = got[got["kind"] == BEGIN]
+    assert len(begin) == 1 and np.allclose(begin[0]["T"], [400.0, 300.0], rtol=0, atol=1e-9)
+    assert (i[0], j[0], start[0], filled[0]) == (1, 2, begin[0]["step"], window)
+    assert len(flux) > window
+    assert np.allclose(history[0], flux[:window], rtol=1e-12, atol=0)
+
+
 def test_events_follow_liggghts_own_contact_list_step_by_step(tmp_path):
     """A pile of 200 spheres settling: at every step, the pairs begun are exactly the pairs
     that compute pair/gran/local lists now and did not list on the step before, and the ended

@@ -182,14 +182,15 @@ def test_an_atom_type_without_material_is_an_error(tmp_path):
 
 @pytest.mark.engines
 def test_offline_agrees_with_the_online_run(pour_dumps, tmp_path):
-    """The pour run by the host (``pyhost run``, contacts sampled every 20 steps) and the same
-    script's own dumps (contacts every 20 steps) post-processed: the same collisions at the
+    """The pour run by the host (``pyhost run``, contacts sampled every 20 steps: ``contacts =
+    "samples"``, as post sees them) and the same script's own dumps (contacts every 20 steps)
+    post-processed: the same collisions at the
     same times, the same impact speeds to the 6 digits the dumps keep, the same heat."""
     for name in ("in.pour", "floor.stl"):
         (tmp_path / name).write_text((pour_dumps / name).read_text())
     (tmp_path / "post").mkdir()
     (tmp_path / "case.toml").write_text('[dem]\nscript = "in.pour"\n\n[effects]\ncontact_heat = "A"\n\n'
-                                        + GLASS + STEEL_WALL + "\n[time]\nsample_every = 20\n\n"
+                                        + GLASS + STEEL_WALL + "\n[time]\ncontacts = \"samples\"\nsample_every = 20\n\n"
                                         "[output]\npictures = false\n")
     online = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "online")],
                             capture_output=True, text=True, cwd=ROOT, timeout=300)

@@ -54,3 +54,19 @@ def test_fast_falls_back_to_exact_outside_tables(paper_pair):
 def test_fast_rejects_unknown_outputs(paper_pair):
     with pytest.raises(ValueError, match="unknown outputs"):
         collide_fast([1.0], paper_pair, "A", outputs=("e", "heat"))
+
+
+def test_table_cache_key_changes_when_any_plugin_file_changes(tmp_path):
+    """The tables depend on every file of the heat plugin: an edit of a model in models/ (not
+    only of the integrators) gives another source digest, hence another cache key, so a stale
+    table is never read."""
+    import shutil
+    from pathlib import Path
+    from plugins.heat import fast
+    root = tmp_path / "heat"
+    shutil.copytree(Path(fast.__file__).parent, root, ignore=shutil.ignore_patterns("__pycache__"))
+    before = fast.source_digest.__wrapped__(root)
+    assert fast.source_digest.__wrapped__(root) == before
+    model = root / "models" / "A.py"
+    model.write_text(model.read_text() + "\n# edited\n")
+    assert fast.source_digest.__wrapped__(root) != before
