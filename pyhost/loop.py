@@ -36,7 +36,7 @@ from pyhost.contact_heat import evaluate_flagged, restitution_impulse, side_heat
 from pyhost.dem_input import script_dem_contacts
 from pyhost import checkpoint, signals
 from pyhost.engines.dem import Dem
-from pyhost.engines.events import BEGIN
+from pyhost.engines.events import BEGIN, END
 from pyhost.failures import particles_lost
 from pyhost.engines.liggghts import LiggghtsError
 from pyhost.outdir import write_atomic
@@ -142,9 +142,11 @@ class Coupling:
         self.progress = Progress(end or math.inf, progress_every)
         self.events = dem.events is not None     # contacts recorded inside LIGGGHTS (else sampled)
         self.t_coll_of = {}                      # (key, begin step) -> t_coll [s] of pair collisions under heat/gran
+        self.restitution = self.events and scene.effects.restitution_feedback and self.effects["particle_temperatures"]
+        self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
         sampled = self.effects["contact_extraction"] and (not self.events or dem.sampled_walls())
         self.every = dict(sample=scene.time.sample_every if sampled else 0,
-                          harvest=HARVEST_EVERY if self.events else 0,
+                          harvest=(scene.time.sample_every if self.restitution else HARVEST_EVERY) if self.events else 0,
                           frame=max(1, round(scene.output.every / dem.dt)),
                           couple=scene.time.couple_every if fluid is not None else 0,
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
@@ -273,7 +275,10 @@ class Coupling:
         arrays = dict(open_keys=self.tracker.open_keys, contact_info=self.info, CT_by_id=self.CT_by_id,
                       seen=self.seen, M_by_id=self.M_by_id, fluid_ids=self.fluid_force[0],
                       fluid_force=self.fluid_force[1], T_ids=atoms.id,
-                      T=atoms.T if self.heat else np.zeros(0))
+                      T=atoms.T if self.heat else np.zeros(0),
+                      target_keys=np.array(list(self.targets), np.int64),
+                      target_speed=np.array([v[0] for v in self.targets.values()]),
+                      target_normal=np.array([v[1] for v in self.targets.values()]).reshape(-1, 3))
         return values, arrays
 
     def restore(self, state: dict) -> None:
@@ -290,6 +295,10 @@ class Coupling:
         checkpoint.restore_forces(self.dem, state)
         self.dem.set_mesh_motion_times(state.get("mesh_motion", {}))
         self.dem.set_random_states(state.get("randoms", {}))
+        if self.restitution and len(state.get("target_keys", ())):   # separation speeds of contacts still open
+            self.dem.events.restitution(state["target_keys"], state["target_speed"], state["target_normal"])
+            self.targets = dict(zip(state["target_keys"].tolist(),
+                                    zip(state["target_speed"].tolist(), state["target_normal"].tolist())))
         if self.heat and "T" in state:       # Temp as it was (a script's fix may not keep it in the restart)
             atoms = self.dem.atoms(True)
             ids, T = state["T_ids"], state["T"]
@@ -489,13 +498,17 @@ class Coupling:
         at its last sample; so is one that began with no approach speed
         (contacts_without_impact)."""
         ev = self.dem.events.take()
-        begin = ev[ev["kind"] == BEGIN]
+        begin, ends = ev[ev["kind"] == BEGIN], ev[ev["kind"] == END]
+        if self.targets and len(ends):         # separation speeds imposed (or not) at these ends
+            for key, imposed in zip(contact_keys(ends["i"], ends["j"]).tolist(), ends["imposed"].tolist()):
+                if self.targets.pop(key, None) is not None and not imposed:
+                    self.totals["restitution_not_imposed"] = self.totals.get("restitution_not_imposed", 0) + 1
         if len(begin):
-            self.collide_begun(atoms, begin)
+            self.collide_begun(atoms, begin, ends)
         if self.dem.events.window:
             self.take_back_heat_gran(atoms, final)
 
-    def collide_begun(self, atoms, begin) -> None:
+    def collide_begun(self, atoms, begin, ends) -> None:
         i = atoms.index(begin["i"])
         j_here = np.where(begin["wall"], 0, atoms.index(np.where(begin["wall"], begin["i"], begin["j"])))
         here = (i >= 0) & (j_here >= 0)
@@ -517,6 +530,44 @@ class Coupling:
                 pair = ~begin["wall"]
                 keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
                 self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), at[pair, 1].tolist()))
+            if self.restitution:
+                self.ask_restitution(atoms, begin, at, ends)
+
+    def ask_restitution(self, atoms, begin, at, ends) -> None:
+        """Restitution feedback on contact events: each collision's separation speed e v0 (e
+        above 1 clipped, counted) handed to the recorder, which imposes it at the step the
+        contact ends. A contact that ended before this harvest (shorter than the harvest
+        interval, time.sample_every steps) gets it now, from the velocities now, as the samples
+        did (counted as restitution_late)."""
+        e, v0 = at[:, 2], at[:, 3]
+        self.totals["clipped"] += int(np.sum(e > 1.0))
+        speed = np.minimum(e, 1.0) * v0
+        keys = contact_keys(begin["i"], begin["j"])
+        ended = {}
+        for key, step in zip(contact_keys(ends["i"], ends["j"]).tolist(), ends["step"].tolist()):
+            ended.setdefault(key, []).append(step)
+        late = np.array([any(s > b for s in ended.get(k, ())) for k, b in zip(keys.tolist(), begin["step"].tolist())],
+                        bool)
+        ask = ~late & ~np.isnan(speed)
+        if ask.any():
+            self.dem.events.restitution(keys[ask], speed[ask], begin["n"][ask])
+            self.targets.update(zip(keys[ask].tolist(), zip(speed[ask].tolist(), begin["n"][ask].tolist())))
+        if late.any():
+            self.totals["restitution_late"] = self.totals.get("restitution_late", 0) + int(late.sum())
+            i = atoms.index(begin["i"][late])
+            wall, jl, _, _, _, m_j = self.partners(atoms, i, begin["j"][late])
+            normal = begin["n"][late].copy()
+            jj = np.where(wall, 0, jl)
+            d = atoms.x[i] - atoms.x[jj]
+            lo, hi, periodic = self.dem.box()
+            d = np.where(periodic, d - (hi - lo) * np.round(d / (hi - lo)), d)
+            normal[~wall] = d[~wall] / np.linalg.norm(d[~wall], axis=1)[:, None]
+            v_j = np.where(wall[:, None], 0.0, atoms.v[jj])
+            dv_i, dv_j, _ = restitution_impulse(atoms.v[i], v_j, atoms.mass[i], m_j, normal, np.minimum(e[late], 1.0),
+                                                v0[late])
+            self.dem.add_velocity(i, dv_i)
+            if (~wall).any():
+                self.dem.add_velocity(jl[~wall], dv_j[~wall])
 
     def take_back_heat_gran(self, atoms, final: bool) -> None:
         """What the script's fix heat/gran conducted through each new pair contact during the
@@ -829,7 +880,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
                                 fluid_force=fluid is not None,
                                 events=scene.time.contacts == "events"
-                                and dem.events_possible(scene.effects.restitution_feedback))
+                                and dem.events_possible())
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
         log("host adds to the script: " + ("; ".join(added) if added else "nothing"))

@@ -19,6 +19,11 @@
 // what heat/gran moved during the collision's model time (pyhost.loop.Coupling.harvest). A
 // history is handed over once full, or when its contact ends (collheat_events_histories).
 //
+// With restitution feedback the host gives each open contact the normal separation speed the
+// heat model's restitution asks for (collheat_events_restitution); at the step the contact
+// ends the recorder imposes it on the pair's normal velocity, conserving momentum (as
+// pyhost.contact_heat.restitution_impulse), and flags the END.
+//
 // Keys as pyhost.collisions.contact_keys: (smaller id << 31) | larger id, a wall being
 // WALL_BASE + its index (> every particle id). Under MPI a pair is recorded by the rank that
 // owns the atom of the smaller id (a wall contact by the atom's owner).
@@ -40,6 +45,7 @@
 #include "fix_mesh_surface.h"
 #include "fix_neighlist_mesh.h"
 #include "tri_mesh.h"
+#include "domain.h"
 #include "fix_property_atom.h"
 #define protected public
 #include "fix_heat_gran_conduction.h"
@@ -50,7 +56,8 @@ using namespace LAMMPS_NS;
 namespace {
 
 enum Kind { PAIR_BEGIN = 0, PAIR_END = 1, WALL_BEGIN = 2, WALL_END = 3 };
-constexpr int ROW = 11; // kind, step, i, j, vn [m/s], nx, ny, nz, duration [steps], T_i, T_j [K] at the begin
+constexpr int ROW = 12; // kind, step, i, j, vn [m/s], nx, ny, nz, duration [steps], T_i, T_j [K] at the begin,
+                        // and for an END whether a separation speed was imposed (1) or not (0)
 constexpr int HEAD = 4; // a flux history: i, j (ids, i < j), step of the begin, steps kept; then the fluxes
 enum Area { OVERLAP = 0, CONSTANT = 1, PROJECTION = 2 };   // FixHeatGranCond's contact area modes
 
@@ -76,6 +83,8 @@ struct Recorder {
     std::vector<double> depth, normal;         // per mesh and local atom, this call: overlap [m] and normal
     bool new_planes = false;                   // planes given since the last call: what touches them is open
     long long begun = 0, ended = 0;
+    struct Target { double speed, n[3]; };     // separation speed [m/s] to impose at the end; a wall's normal
+    std::unordered_map<uint64_t, Target> targets;
     FixHeatGranCond *conduction = nullptr;     // a script's fix heat/gran, or none
     int window = 0;                            // steps of flux kept per new pair contact
     std::vector<History> histories;            // in use or free (free: start < 0)
@@ -103,9 +112,9 @@ struct Recorder {
     std::unordered_map<uint64_t, std::pair<bigint, int>> carry;
 
     void event(int kind, bigint step, double i, double j, double vn, const double *n, double duration,
-               double Ti = NAN, double Tj = NAN)
+               double Ti = NAN, double Tj = NAN, double imposed = 0.0)
     {
-        const double row[ROW] = {double(kind), double(step), i, j, vn, n[0], n[1], n[2], duration, Ti, Tj};
+        const double row[ROW] = {double(kind), double(step), i, j, vn, n[0], n[1], n[2], duration, Ti, Tj, imposed};
         rows.insert(rows.end(), row, row + ROW);
     }
 
@@ -215,8 +224,45 @@ struct Recorder {
         const uint64_t lo = k_ >> 31, hi = k_ & ((uint64_t(1) << 31) - 1);
         const bool wall = hi >= (uint64_t(1) << 30);
         const double none[3] = {0, 0, 0};
-        event(wall ? WALL_END : PAIR_END, step, double(lo), double(hi), 0.0, none, double(step - start));
+        const bool imposed = !targets.empty() && impose(k_);
+        event(wall ? WALL_END : PAIR_END, step, double(lo), double(hi), 0.0, none, double(step - start), NAN, NAN,
+              imposed ? 1.0 : 0.0);
         ++ended;
+    }
+
+    // The separation speed asked for contact k_ (if the host gave one) imposed now on the normal
+    // velocity of its pair (the line of centres, nearest image) or particle (a wall: the normal
+    // at its begin), momentum conserved. False if there is none, or an atom is not local here.
+    bool impose(uint64_t k_)
+    {
+        auto it = targets.find(k_);
+        if (it == targets.end()) return false;
+        const Target t = it->second;
+        targets.erase(it);
+        Atom *atom = lmp->atom;
+        const tagint lo = tagint(k_ >> 31), hi = tagint(k_ & ((uint64_t(1) << 31) - 1));
+        const bool wall = hi >= (tagint(1) << 30);
+        const int a = atom->map(lo), b = wall ? -1 : atom->map(hi);
+        if (a < 0 || a >= atom->nlocal || (!wall && (b < 0 || b >= atom->nlocal))) return false;
+        double **x = atom->x, **v = atom->v;
+        const double *m = atom->rmass;
+        double n[3] = {t.n[0], t.n[1], t.n[2]};
+        if (!wall) {
+            double d[3] = {x[a][0] - x[b][0], x[a][1] - x[b][1], x[a][2] - x[b][2]};
+            lmp->domain->minimum_image(d);
+            const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            if (!(len > 0)) return false;
+            for (int c = 0; c < 3; ++c) n[c] = d[c] / len;
+        }
+        const double vb[3] = {wall ? 0.0 : v[b][0], wall ? 0.0 : v[b][1], wall ? 0.0 : v[b][2]};
+        const double separation = (v[a][0] - vb[0]) * n[0] + (v[a][1] - vb[1]) * n[1] + (v[a][2] - vb[2]) * n[2];
+        const double change = t.speed - separation;
+        const double share_a = wall ? 1.0 : m[b] / (m[a] + m[b]), share_b = wall ? 0.0 : m[a] / (m[a] + m[b]);
+        for (int c = 0; c < 3; ++c) {
+            v[a][c] += share_a * change * n[c];
+            if (!wall) v[b][c] -= share_b * change * n[c];
+        }
+        return true;
     }
 
     void record(bigint step)
@@ -529,6 +575,22 @@ int collheat_events_appeared(void *handle, double *out, int n)
     rec->appeared.erase(rec->appeared.begin(), rec->appeared.begin() + 2 * n);
     return n;
 }
+
+// Separation speeds to impose at the end of n open contacts: their keys, the speed [m/s] and,
+// for a wall, the normal from the wall to the particle.
+void collheat_events_restitution(void *handle, int n, const int64_t *keys, const double *speed, const double *normal)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    for (int k = 0; k < n; ++k) {
+        Recorder::Target t;
+        t.speed = speed[k];
+        for (int c = 0; c < 3; ++c) t.n[c] = normal[3 * k + c];
+        rec->targets[uint64_t(keys[k])] = t;
+    }
+}
+
+// Forget every separation speed not imposed yet (their contacts are not open any more).
+void collheat_events_forget_restitution(void *handle) { static_cast<Recorder *>(handle)->targets.clear(); }
 
 // Events waiting, open contacts now, and all BEGIN and END events recorded so far.
 int collheat_events_waiting(void *handle) { return int(static_cast<Recorder *>(handle)->rows.size() / ROW); }

@@ -190,12 +190,12 @@ class Dem:
             raise ScriptError(f"run {steps}{' upto' if upto else ''}: {why} (LIGGGHTS: 'Invalid run command')")
         return n
 
-    def events_possible(self, restitution_feedback: bool) -> bool:
+    def events_possible(self) -> bool:
         """Whether the contact events can stand for samples of the pair contacts: serial (each
-        rank's own events are the issue on MPI) and no restitution feedback (imposed at the
-        sample that sees a contact end). A fix heat/gran's conduction during a collision is
-        taken back from the recorder's flux histories (``HEAT_GRAN_WINDOW``)."""
-        return self.link is None and not restitution_feedback
+        rank's own events are the issue on MPI). A fix heat/gran's conduction during a
+        collision is taken back from the recorder's flux histories (``HEAT_GRAN_WINDOW``); a
+        restitution feedback's separation speed is imposed by the recorder at the contact's end."""
+        return self.link is None
 
     def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
                 events: bool = False) -> list[str]:

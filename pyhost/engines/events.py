@@ -13,7 +13,8 @@ With a script's fix heat/gran, ``conduction(fix, window)`` has the recorder also
 heat/gran conducts through each new pair contact at each of its first ``window`` steps (its
 own formula, in compiled code); ``histories()`` hands them over once full or ended; and each
 BEGIN carries T, the two temperatures [K] at its step (NaN without heat/gran; for a wall, the
-particle's and NaN).
+particle's and NaN). ``restitution(keys, speeds, normals)`` has the recorder impose those
+separation speeds at the step each contact ends (restitution feedback); the END says so.
 """
 from __future__ import annotations
 
@@ -22,10 +23,10 @@ import ctypes
 import numpy as np
 
 FIX = "collheat_events"
-ROW = 11
+ROW = 12
 BEGIN, END = 0, 1
 EVENT = np.dtype([("kind", np.int8), ("wall", np.bool_), ("step", np.int64), ("i", np.int64), ("j", np.int64),
-                  ("vn", float), ("n", float, 3), ("duration", np.int64), ("T", float, 2)])
+                  ("vn", float), ("n", float, 3), ("duration", np.int64), ("T", float, 2), ("imposed", np.bool_)])
 
 _c = ctypes
 _vp, _int, _dp = _c.c_void_p, _c.c_int, _c.POINTER(_c.c_double)
@@ -45,6 +46,8 @@ _DECLARATIONS = {
     "collheat_events_take_histories": (_int, [_vp, _dp, _int]),
     "collheat_events_appeared": (_int, [_vp, _dp, _int]),
     "collheat_events_cylinders": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp, _dp, _dp]),
+    "collheat_events_restitution": (None, [_vp, _int, _c.POINTER(_c.c_int64), _dp, _dp]),
+    "collheat_events_forget_restitution": (None, [_vp]),
 }
 HEAD = 4
 
@@ -82,6 +85,19 @@ class ContactEvents:
         if n:
             raw = raw[:h.collheat_events_appeared(self.handle, raw.ctypes.data_as(_dp), n)]
         return raw[:, 0].astype(np.int64), raw[:, 1]
+
+    def restitution(self, keys, speed, normal) -> None:
+        """Separation speeds [m/s] to impose on open contacts (``pyhost.collisions.contact_keys``)
+        at the step each ends; ``normal`` (n, 3): a wall's, from the wall to the particle (a
+        pair takes its line of centres then). An END event says whether it was imposed."""
+        keys = np.ascontiguousarray(keys, dtype=np.int64)
+        speed = np.ascontiguousarray(speed, dtype=float)
+        normal = np.ascontiguousarray(np.reshape(normal, (-1, 3)), dtype=float)
+        self.lmp.helper.collheat_events_restitution(self.handle, len(keys), keys.ctypes.data_as(_c.POINTER(_c.c_int64)),
+                                                    speed.ctypes.data_as(_dp), normal.ctypes.data_as(_dp))
+
+    def forget_restitution(self) -> None:
+        self.lmp.helper.collheat_events_forget_restitution(self.handle)
 
     def histories(self, all: bool = False) -> tuple:
         """The flux histories handed over (with ``all``, also those still filling, which the
@@ -159,6 +175,7 @@ class ContactEvents:
         out["n"] = raw[:, 5:8]
         out["duration"] = raw[:, 8]
         out["T"] = raw[:, 9:11]
+        out["imposed"] = raw[:, 11] > 0
         return out
 
     def close(self) -> None:

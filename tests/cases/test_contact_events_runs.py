@@ -1,6 +1,6 @@
 """Collisions from contact events recorded inside LIGGGHTS ([time] contacts = "events", the
 default where it applies) against the sampled contact lists ("samples"), on the small cases
-run for real. Restitution feedback is off in both: it needs samples."""
+run for real. Restitution feedback is off unless a test says otherwise."""
 import csv
 import json
 import re
@@ -19,10 +19,12 @@ pytestmark = pytest.mark.engines
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
 
-def run(case, tmp_path, mode, *extra):
+def run(case, tmp_path, mode, *extra, restitution=False):
     folder = tmp_path / f"{case}-{mode}"
     shutil.copytree(CASES / case, folder)
-    text = (folder / "case.toml").read_text().replace("restitution_feedback = true", "restitution_feedback = false")
+    text = (folder / "case.toml").read_text()
+    if not restitution:
+        text = text.replace("restitution_feedback = true", "restitution_feedback = false")
     (folder / "case.toml").write_text(re.sub(r"^\[time\]$", f'[time]\ncontacts = "{mode}"', text, count=1,
                                              flags=re.M))
     r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(folder), "--out", str(folder / "out"), *extra],
@@ -95,3 +97,27 @@ def test_a_script_with_fix_heat_gran_runs_on_events(tmp_path):
     assert ev["heat_moved"] == pytest.approx(sa["heat_moved"], rel=1e-2)
     assert 0 < ev["heat_gran_undone"] < sa["heat_gran_undone"]
     assert abs(ev["energy_balance_error"]) < 1e-12
+
+
+def test_restitution_feedback_on_events_is_imposed_at_the_contact_end(tmp_path):
+    """two-particles with restitution feedback (the model's e imposed when the contact ends):
+    the recorder imposes e v0 on the pair's normal velocity at the step the contact ends, so
+    the spheres fly apart at the model's e times 0.4 m/s to 1e-12 (nothing acts on them after),
+    none imposed late; the samples' run, which imposes it at the first sample after the end,
+    the same to 1e-9 (its v0 comes from the back-integration, 1.5e-5 off)."""
+    import meshio
+
+    def rebound(folder):
+        last = sorted((folder / "out" / "vtk").glob("particles_*.vtu"))[-1]
+        v = meshio.read(last).point_data["velocity"]
+        return v[1, 0] - v[0, 0]
+
+    ev_rows, ev = run("two-particles", tmp_path, "events", restitution=True)
+    sa_rows, sa = run("two-particles", tmp_path, "samples", restitution=True)
+    assert ev["collisions"] == sa["collisions"] == 1
+    assert "restitution_late" not in ev and "restitution_not_imposed" not in ev
+    e, v0 = float(ev_rows[0]["e"]), float(ev_rows[0]["v0"])
+    assert 0 < e < 1 and v0 == pytest.approx(0.4, rel=1e-12)
+    assert rebound(tmp_path / "two-particles-events") == pytest.approx(e * v0, rel=1e-12)
+    e_s, v0_s = float(sa_rows[0]["e"]), float(sa_rows[0]["v0"])
+    assert rebound(tmp_path / "two-particles-samples") == pytest.approx(e_s * v0_s, rel=1e-9)
