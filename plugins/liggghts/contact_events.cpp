@@ -80,7 +80,8 @@ struct Recorder {
     std::vector<double> cyl_radius, cyl_c1, cyl_c2, cyl_code;   // two other coordinates [m], code
     std::vector<FixMeshSurface *> meshes;       // mesh walls: the fix mesh/surface and the code
     std::vector<double> mesh_code;             // of its contacts (one per particle and mesh: the deepest)
-    std::vector<double> depth, normal;         // per mesh and local atom, this call: overlap [m] and normal
+    std::vector<double> depth, normal;         // per mesh and local atom, this call: overlap [m] and normal,
+    std::vector<int> deepest;                  // and the deepest triangle
     bool new_planes = false;                   // planes given since the last call: what touches them is open
     long long begun = 0, ended = 0;
     struct Target { double speed, n[3]; };     // separation speed [m/s] to impose at the end; a wall's normal
@@ -378,10 +379,14 @@ struct Recorder {
         }
         // mesh walls: LIGGGHTS' own candidates of each triangle and its own contact test
         // (TriMesh::resolveTriSphereContact: distance - radius < 0), the deepest triangle
-        // giving the normal, turned to point from the wall to the particle
+        // giving the normal, turned to point from the wall to the particle. A moving mesh
+        // (fix move/mesh) gives the wall's velocity at the contact point, as fix wall/gran
+        // takes it: its triangle's node velocities weighted by the point's barycentric
+        // coordinates; the approach speed is the relative one.
         if (!meshes.empty()) {
             depth.assign(meshes.size() * size_t(nlocal), 0.0);
             normal.resize(3 * meshes.size() * size_t(nlocal));
+            deepest.resize(meshes.size() * size_t(nlocal));
         }
         for (size_t m = 0; m < meshes.size(); ++m) {
             TriMesh *mesh = meshes[m]->triMesh();
@@ -398,6 +403,7 @@ struct Recorder {
                     double &best = depth[m * nlocal + p];
                     if (dn >= 0 || dn >= best) continue;
                     best = dn;
+                    deepest[m * nlocal + p] = t;
                     double node0[3];
                     mesh->node(t, 0, node0);
                     const double len = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
@@ -408,11 +414,22 @@ struct Recorder {
                     n[0] = delta[0] * s; n[1] = delta[1] * s; n[2] = delta[2] * s;
                 }
             }
+            MultiVectorContainer<double, 3, 3> *moving = mesh->prop().getElementProperty<MultiVectorContainer<double, 3, 3> >("v");
             for (int i = 0; i < nlocal; ++i, ++k) {
                 if (depth[m * nlocal + i] >= 0) { off(k, step, rebuilt); continue; }
                 if (touch[k] && !rebuilt) continue;
                 const double *n = &normal[3 * (m * nlocal + i)];
-                const double vn = -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]);   // the wall's own motion left out
+                double vw[3] = {0, 0, 0};
+                if (moving) {
+                    const int t = deepest[m * nlocal + i];
+                    double point[3], bary[3];
+                    int barysign;
+                    mesh->resolveTriSphereContactBary(i, t, r[i], x[i], point, bary, barysign);
+                    double ***node_v = moving->begin();
+                    for (int c = 0; c < 3; ++c)
+                        vw[c] = bary[0] * node_v[t][0][c] + bary[1] * node_v[t][1][c] + bary[2] * node_v[t][2][c];
+                }
+                const double vn = -((v[i][0] - vw[0]) * n[0] + (v[i][1] - vw[1]) * n[1] + (v[i][2] - vw[2]) * n[2]);
                 on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]), tag[i], mesh_code[m],
                    i, -1, vn, n, new_planes);
             }

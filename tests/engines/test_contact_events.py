@@ -274,3 +274,30 @@ def test_mesh_wall_events_follow_liggghts_own_wall_contact_list(tmp_path):
     assert begun >= 10
     assert first["vn"] == pytest.approx(math.sqrt(2 * 9.81 * h), rel=1e-2)
     assert np.allclose(first["n"], [0, 0, 1], atol=1e-9)
+
+
+def test_a_moving_mesh_meets_a_particle_at_its_own_speed(tmp_path):
+    """An STL plate moved up at 0.2 m/s by fix move/mesh into a sphere at rest (no gravity):
+    the contact begins with the relative approach speed, the plate's 0.2 m/s (to 1e-9), not
+    the particle's 0; the normal points from the plate up to the sphere."""
+    (tmp_path / "floor.stl").write_text(FLOOR)
+    V = 0.2
+    with box(tmp_path, dt=1e-6) as lg:
+        lg.commands(f"""
+            fix cad all mesh/surface file {tmp_path / 'floor.stl'} type 1
+            fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad
+            fix lift all move/mesh mesh cad linear 0. 0. {V}
+            create_atoms 1 single 0.001 -0.002 {-0.01 + R + 0.0005} units box
+            set atom 1 diameter {2 * R} density {RHO}
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        lg.run(1)
+        assert ev.meshes(["cad"], [WALL_BASE + 0])
+        lg.run(5000)                             # the plate closes the 0.5 mm gap in 2500 steps
+        got = ev.take()
+    begin = got[(got["kind"] == BEGIN) & got["wall"]]
+    assert len(begin) >= 1
+    print(f"begin at step {begin[0]['step']}, vn {begin[0]['vn']:.12f} m/s")
+    assert begin[0]["vn"] == pytest.approx(V, rel=1e-9)
+    assert np.allclose(begin[0]["n"], [0, 0, 1], atol=1e-9)

@@ -42,12 +42,22 @@ def settle(workdir, law: str) -> tuple[list, float]:
             fix integrate all nve/sphere
         """)
         dem.run(0)
+        # the set-up made fix external's array from uninitialised memory and took it as a force;
+        # the first step (run ... pre no) would start from that force (the sphere, now and then,
+        # left the box): zero it and set up again, as pyhost.engines.dem.Dem.prepare does
+        dem.external_force("fluid")[:] = 0.0
+        dem.commands("run 0")
         vz = []
-        for _ in range(steps):
+        for k in range(steps):
+            x, v = dem.atom("x").copy(), dem.atom("v").copy()
             force = fluid.couple(dem.atom("x"), dem.atom("v"), 2 * dem.atom("radius"),
                                  every * dt_dem)
             dem.external_force("fluid")[:] = force
             dem.run(every)
+            if len(dem.atom("v")) == 0:     # say what it saw
+                raise RuntimeError(f"the sphere left the box in coupling {k}: it was at x {x.tolist()} m, "
+                                   f"v {v.tolist()} m/s, the fluid force {force.tolist()} N, fraction "
+                                   f"{fluid.alpha.min()}")
             vz.append(float(-dem.atom("v")[0, 2]))
         return vz, float(fluid.alpha.min())
 
