@@ -120,20 +120,12 @@ def restore_forces(dem, state: dict) -> None:
     _put_forces(dem, state["ids"], state["f"], state["torque"])
 
 
-def refuse(scene) -> str | None:
-    """Why this scene cannot be restarted (None: it can). Every scene can now; a script's
-    commands that a restart cannot replay are refused by ``pyhost.script.replay``."""
-    return None
-
-
 def load(out: Path, scene) -> dict:
     """The checkpoint in OUT/checkpoint checked against this scene and this code: its host
     state (values and arrays in one dict) and ``restart``, the path of LIGGGHTS' restart
     file. UserError (exit 2) saying why if there is none, it belongs to another case or
-    another code version, or it is damaged; nothing is written."""
-    why = refuse(scene)
-    if why:
-        raise UserError(f"--restart: {why}")
+    another code version, or it is damaged; nothing is written. (Every scene restarts; a
+    script's commands that a restart cannot replay are refused by ``pyhost.script.replay``.)"""
     folder = Path(out) / FOLDER
     if not folder.is_dir() and (Path(out) / ".checkpoint.old").is_dir():
         folder = Path(out) / ".checkpoint.old"    # a write was cut between its two renames

@@ -156,7 +156,6 @@ class Coupling:
         self.inputs = ()                     # the script's files (a restart checks them)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
         self.resumed = resume is not None    # the next advance continues the checkpoint's run
-        self.restartable = checkpoint.refuse(scene) is None     # a signal's stop writes a checkpoint
         self.checkpoint_step = -1            # the step of the last checkpoint written
         if resume is not None:
             self.restore(resume)
@@ -190,7 +189,7 @@ class Coupling:
         """n coupled DEM steps: the loop of the module doc. With checkpoints, a signal stops it
         only at the end of a step, where the state is whole (``signals.deferred``), and a
         checkpoint is written there (``run_scene``), periodic checkpoints asked for or not."""
-        with signals.deferred(self.restartable):
+        with signals.deferred():
             self._advance(n)
 
     def _advance(self, n: int) -> None:
@@ -301,15 +300,10 @@ class Coupling:
                                     zip(state["target_speed"].tolist(), state["target_normal"].tolist())))
         if self.heat and "T" in state:       # Temp as it was (a script's fix may not keep it in the restart)
             atoms = self.dem.atoms(True)
-            ids, T = state["T_ids"], state["T"]
-            order = np.argsort(ids)
-            atoms.T[:] = T[order[np.searchsorted(ids, atoms.id, sorter=order)]]
+            atoms.T[:] = _by_id(state["T_ids"], state["T"], atoms.id)
         if self.fluid is not None:          # the fluid force of the last coupling, until the next
             ids, force = state["fluid_ids"], state["fluid_force"]
-            atoms = self.dem.atoms(False)
-            order = np.argsort(ids)
-            at = order[np.searchsorted(ids, atoms.id, sorter=order)]
-            self.dem.set_force(force[at])
+            self.dem.set_force(_by_id(ids, force, self.dem.atoms(False).id))
             self.fluid_force = (ids, force)
 
     # -- particles ----------------------------------------------------------------------
@@ -346,9 +340,9 @@ class Coupling:
             # under heat/gran an atom seen some steps after its insertion may have been conducted
             # to since: the recorder noted its Temp at its first step, which is what came in
             came, T_came = self.dem.events.appeared()
-            T_first = np.full(len(self.seen), np.nan)
-            T_first[came[came < len(self.seen)]] = T_came[came < len(self.seen)]
-            T_entry = np.where(np.isnan(T_first[ids[new]]), T_entry, T_first[ids[new]])
+            if len(came) and new.any():
+                first = _by_id(came, T_came, ids[new], missing=np.nan)
+                T_entry = np.where(np.isnan(first), T_entry, first)
         if new.any():
             T_set = self.initial_T(atoms, new)
             atoms.T[new] += np.where(np.isnan(T_set), 0.0, T_set - T_entry)    # what it was conducted kept
@@ -554,20 +548,8 @@ class Coupling:
             self.targets.update(zip(keys[ask].tolist(), zip(speed[ask].tolist(), begin["n"][ask].tolist())))
         if late.any():
             self.totals["restitution_late"] = self.totals.get("restitution_late", 0) + int(late.sum())
-            i = atoms.index(begin["i"][late])
-            wall, jl, _, _, _, m_j = self.partners(atoms, i, begin["j"][late])
-            normal = begin["n"][late].copy()
-            jj = np.where(wall, 0, jl)
-            d = atoms.x[i] - atoms.x[jj]
-            lo, hi, periodic = self.dem.box()
-            d = np.where(periodic, d - (hi - lo) * np.round(d / (hi - lo)), d)
-            normal[~wall] = d[~wall] / np.linalg.norm(d[~wall], axis=1)[:, None]
-            v_j = np.where(wall[:, None], 0.0, atoms.v[jj])
-            dv_i, dv_j, _ = restitution_impulse(atoms.v[i], v_j, atoms.mass[i], m_j, normal, np.minimum(e[late], 1.0),
-                                                v0[late])
-            self.dem.add_velocity(i, dv_i)
-            if (~wall).any():
-                self.dem.add_velocity(jl[~wall], dv_j[~wall])
+            self.impose_separation(atoms, begin["i"][late], begin["j"][late], begin["n"][late],
+                                   np.minimum(e[late], 1.0), v0[late])
 
     def take_back_heat_gran(self, atoms, final: bool) -> None:
         """What the script's fix heat/gran conducted through each new pair contact during the
@@ -673,26 +655,32 @@ class Coupling:
             return
         ids_i = (closed >> 31).astype(np.int64)
         ids_j = (closed & ((1 << 31) - 1)).astype(np.int64)
+        self.totals["clipped"] += self.impose_separation(atoms, ids_i, ids_j, info[:, 4:7], info[:, 2], info[:, 3])
+
+    def impose_separation(self, atoms, ids_i, ids_j, normal, e, v0) -> int:
+        """The model's separation speed e v0 [m/s] imposed now on each pair's normal velocity
+        (particles ``ids_i`` and ``ids_j``, or WALL_BASE + wall: the line of centres, nearest
+        image; a wall's ``normal`` as given), momentum conserved; skipped where a particle is
+        gone or e is NaN (contacts there at a restart: no collision). Returns how many e above
+        1 were clipped."""
         i = atoms.index(ids_i)
-        e = info[:, 2]
-        here = (i >= 0) & ~np.isnan(e)         # contacts there at a restart: no collision
+        here = (i >= 0) & ~np.isnan(e)
         wall, jl, _, _, _, m_j = self.partners(atoms, np.maximum(i, 0), ids_j)
         here &= wall | (jl >= 0)
-        normal = info[:, 4:7].copy()
+        normal = np.array(normal, float)
         jj = np.where(wall, 0, np.maximum(jl, 0))
         d = atoms.x[np.maximum(i, 0)] - atoms.x[jj]
         lo, hi, periodic = self.dem.box()
         d = np.where(periodic, d - (hi - lo) * np.round(d / (hi - lo)), d)
         normal[~wall] = d[~wall] / np.linalg.norm(d[~wall], axis=1)[:, None]
-        v0 = info[:, 3]
         v_j = np.where(wall[:, None], 0.0, atoms.v[jj])
         dv_i, dv_j, clipped = restitution_impulse(atoms.v[np.maximum(i, 0)], v_j, atoms.mass[np.maximum(i, 0)],
                                                   m_j, normal, e, v0)
-        self.totals["clipped"] += clipped
         self.dem.add_velocity(i[here], dv_i[here])
         pair = here & ~wall
         if pair.any():
             self.dem.add_velocity(jl[pair], dv_j[pair])
+        return clipped
 
     def undo_heat_gran(self, atoms, c) -> None:
         """The script's fix heat/gran conducts through every contact; during a collision's
@@ -940,7 +928,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                               f"the script" + (", or the coupled time as [time] end" if fluid is not None else ""))
     except BaseException as exc:          # keep what was computed: summary of the run so far
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
-                and coupling.restartable and coupling.checkpoint_step != dem.step:   # (not twice at one step)
+                and coupling.checkpoint_step != dem.step:   # (not twice at one step)
             try:
                 coupling.flush_events()
                 checkpoint.write(coupling)
@@ -956,3 +944,16 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     if coupling is None:
         raise ScriptError(f"{scene.path}: the script has no 'run' command: nothing to simulate")
     return coupling.finish()
+
+
+def _by_id(ids, values, wanted, missing=None):
+    """``values`` (aligned with the atom ids ``ids``) for the ids ``wanted``, in their order;
+    an id not among ``ids`` gets ``missing`` (None: every one must be there)."""
+    ids = np.asarray(ids)
+    order = np.argsort(ids, kind="stable")
+    at = np.minimum(np.searchsorted(ids, wanted, sorter=order), max(len(ids) - 1, 0))
+    rows = order[at]
+    if missing is None:
+        return np.asarray(values)[rows]
+    found = ids[rows] == wanted
+    return np.where(found, np.asarray(values)[rows], missing)

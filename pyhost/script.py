@@ -145,8 +145,7 @@ def _check_if(cmd: Command) -> None:
 
 BOX = ("create_box", "read_data", "read_restart")
 STATE = {"create_atoms", "delete_atoms", "displace_atoms", "set", "velocity", "read_dump", "change_box",
-         "reset_timestep", "group", "write_restart", "write_data", "write_dump", "print", "create_box",
-         "read_data", "read_restart"}
+         "reset_timestep", "group", "write_restart", "write_data", "write_dump", "print", *BOX}
 """Commands whose effect is in LIGGGHTS' restart file (atoms and their values, groups, the box,
 the step) or that only wrote output: a restart does not replay them."""
 

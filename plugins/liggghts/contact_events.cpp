@@ -561,10 +561,8 @@ int collheat_events_histories(void *handle, int all)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
     if (all) {
-        for (size_t k = 0; k < rec->history.size(); ++k)
+        for (size_t k = 0; k < rec->history.size(); ++k)     // (``carry`` is empty between steps)
             if (rec->history[k] >= 0) { rec->close_history(rec->history[k]); rec->history[k] = -1; }
-        for (auto &c : rec->carry)
-            if (c.second.second >= 0) { rec->close_history(c.second.second); c.second.second = -1; }
     }
     return rec->window ? int(rec->done.size() / (HEAD + rec->window)) : 0;
 }
@@ -605,9 +603,6 @@ void collheat_events_restitution(void *handle, int n, const int64_t *keys, const
         rec->targets[uint64_t(keys[k])] = t;
     }
 }
-
-// Forget every separation speed not imposed yet (their contacts are not open any more).
-void collheat_events_forget_restitution(void *handle) { static_cast<Recorder *>(handle)->targets.clear(); }
 
 // Events waiting, open contacts now, and all BEGIN and END events recorded so far.
 int collheat_events_waiting(void *handle) { return int(static_cast<Recorder *>(handle)->rows.size() / ROW); }

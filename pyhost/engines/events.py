@@ -47,7 +47,6 @@ _DECLARATIONS = {
     "collheat_events_appeared": (_int, [_vp, _dp, _int]),
     "collheat_events_cylinders": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp, _dp, _dp]),
     "collheat_events_restitution": (None, [_vp, _int, _c.POINTER(_c.c_int64), _dp, _dp]),
-    "collheat_events_forget_restitution": (None, [_vp]),
 }
 HEAD = 4
 
@@ -95,9 +94,6 @@ class ContactEvents:
         normal = np.ascontiguousarray(np.reshape(normal, (-1, 3)), dtype=float)
         self.lmp.helper.collheat_events_restitution(self.handle, len(keys), keys.ctypes.data_as(_c.POINTER(_c.c_int64)),
                                                     speed.ctypes.data_as(_dp), normal.ctypes.data_as(_dp))
-
-    def forget_restitution(self) -> None:
-        self.lmp.helper.collheat_events_forget_restitution(self.handle)
 
     def histories(self, all: bool = False) -> tuple:
         """The flux histories handed over (with ``all``, also those still filling, which the
