@@ -339,7 +339,7 @@ class Coupling:
         if self.dem.events is not None and self.dem.events.window:
             # under heat/gran an atom seen some steps after its insertion may have been conducted
             # to since: the recorder noted its Temp at its first step, which is what came in
-            came, T_came = self.dem.events.appeared()
+            came, T_came, _ = self.dem.events.appeared()
             if len(came) and new.any():
                 first = _by_id(came, T_came, ids[new], missing=np.nan)
                 T_entry = np.where(np.isnan(first), T_entry, first)
@@ -493,14 +493,41 @@ class Coupling:
         (contacts_without_impact)."""
         ev = self.dem.events.take()
         begin, ends = ev[ev["kind"] == BEGIN], ev[ev["kind"] == END]
-        if self.targets and len(ends):         # separation speeds imposed (or not) at these ends
-            for key, imposed in zip(contact_keys(ends["i"], ends["j"]).tolist(), ends["imposed"].tolist()):
-                if self.targets.pop(key, None) is not None and not imposed:
-                    self.totals["restitution_not_imposed"] = self.totals.get("restitution_not_imposed", 0) + 1
+        if self.dem.events.joined:               # open contacts that moved between ranks (MPI)
+            self.totals["contacts_changed_rank"] = self.totals.get("contacts_changed_rank", 0) + len(self.dem.events.joined)
+        if self.targets and len(ends):
+            self.ended_with_targets(atoms, ends)
         if len(begin):
             self.collide_begun(atoms, begin, ends)
         if self.dem.events.window:
+            dt = self.dem.dt
+            for key, began, moved in self.dem.events.joined:   # a flux history goes on on another rank
+                if (key, began) in self.t_coll_of:
+                    self.t_coll_of[key, moved] = self.t_coll_of[key, began] - (moved - began) * dt
             self.take_back_heat_gran(atoms, final)
+
+    def ended_with_targets(self, atoms, ends) -> None:
+        """Contacts given a separation speed that ended since the last harvest: the recorder
+        imposed it at the end, unless the pair's atoms were on two ranks (MPI: the recorder
+        changes only its own rank's atoms) or one was gone. Those get it now, from the
+        velocities now (restitution_late), as a contact shorter than the harvest interval does.
+        Under MPI every rank forgets these contacts' speeds (each keeps all, as a contact may
+        move between ranks)."""
+        keys = contact_keys(ends["i"], ends["j"])
+        late = []
+        for r, (key, imposed) in enumerate(zip(keys.tolist(), ends["imposed"].tolist())):
+            target = self.targets.pop(key, None)
+            if target is not None and not imposed:
+                late.append((r,) + target)
+        if self.dem.link is not None:
+            self.dem.events.forget(keys)
+        if late:
+            rows = np.array([r for r, _, _ in late])
+            present = (atoms.index(ends["i"][rows]) >= 0) & (ends["wall"][rows] | (atoms.index(ends["j"][rows]) >= 0))
+            self.totals["restitution_not_imposed"] = self.totals.get("restitution_not_imposed", 0) + int((~present).sum())
+            self.totals["restitution_late"] = self.totals.get("restitution_late", 0) + int(present.sum())
+            self.impose_separation(atoms, ends["i"][rows], ends["j"][rows], np.array([n for _, _, n in late]),
+                                   np.ones(len(rows)), np.array([v for _, v, _ in late]))
 
     def collide_begun(self, atoms, begin, ends) -> None:
         i = atoms.index(begin["i"])
@@ -867,8 +894,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
         try:
             added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
                                 fluid_force=fluid is not None,
-                                events=scene.time.contacts == "events"
-                                and dem.events_possible())
+                                events=scene.time.contacts == "events")
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
         log("host adds to the script: " + ("; ".join(added) if added else "nothing"))

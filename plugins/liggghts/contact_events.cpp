@@ -25,8 +25,13 @@
 // pyhost.contact_heat.restitution_impulse), and flags the END.
 //
 // Keys as pyhost.collisions.contact_keys: (smaller id << 31) | larger id, a wall being
-// WALL_BASE + its index (> every particle id). Under MPI a pair is recorded by the rank that
-// owns the atom of the smaller id (a wall contact by the atom's owner).
+// WALL_BASE + its index (> every particle id). Under MPI each rank has its own recorder and a
+// pair is recorded by the rank that owns the atom of the smaller id (a wall contact by the
+// atom's owner). An open contact whose atom moves to another rank (at a neighbour build, where
+// LIGGGHTS exchanges atoms) ends on the old rank and begins on the new one at that step: the
+// END says MOVED (its atom is no longer here) and every BEGIN at a build says MOVED (it may
+// have come from another rank); the host pairs them by key and step (pyhost.engines.events
+// .join_moved), and what is left of either is a real event.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -47,6 +52,7 @@
 #include "tri_mesh.h"
 #include "domain.h"
 #include "fix_property_atom.h"
+#include "comm.h"
 #define protected public
 #include "fix_heat_gran_conduction.h"
 #undef protected
@@ -57,7 +63,8 @@ namespace {
 
 enum Kind { PAIR_BEGIN = 0, PAIR_END = 1, WALL_BEGIN = 2, WALL_END = 3 };
 constexpr int ROW = 12; // kind, step, i, j, vn [m/s], nx, ny, nz, duration [steps], T_i, T_j [K] at the begin,
-                        // and for an END whether a separation speed was imposed (1) or not (0)
+                        // and flags: IMPOSED (an END's separation speed was imposed), MOVED (see above)
+constexpr double IMPOSED = 1.0, MOVED = 2.0;
 constexpr int HEAD = 4; // a flux history: i, j (ids, i < j), step of the begin, steps kept; then the fluxes
 enum Area { OVERLAP = 0, CONSTANT = 1, PROJECTION = 2 };   // FixHeatGranCond's contact area modes
 
@@ -92,7 +99,9 @@ struct Recorder {
     std::vector<int> free_histories;
     std::vector<double> done;                  // histories handed over: HEAD + window doubles each
     tagint max_tag = -1;                       // with heat/gran: the largest id seen, and each new
-    std::vector<double> appeared;              // atom's id and Temp at its first step (before heat/gran moves any)
+    std::vector<double> appeared;              // atom's id, Temp at its first step (before heat/gran moves any)
+                                               // and that step (under MPI an atom that moves in may be
+                                               // larger than all this rank saw: the host keeps the first)
 
     // The state of the contacts, laid out like the neighbour list (one slot per entry, in
     // the order of ilist and each atom's neighbours) and, for the planes, like the local
@@ -141,7 +150,8 @@ struct Recorder {
         since[k] = step;
         if (primed && !quiet) {
             const double *T = conduction ? conduction->Temp : nullptr;
-            event(kind, step, i, j, vn, n, 0.0, T ? T[li] : NAN, T && lj >= 0 ? T[lj] : NAN);
+            event(kind, step, i, j, vn, n, 0.0, T ? T[li] : NAN, T && lj >= 0 ? T[lj] : NAN,
+                  rebuilt && lmp->comm->nprocs > 1 ? MOVED : 0.0);
             ++begun;
             if (conduction && kind == PAIR_BEGIN) history[k] = open_history(k_, step);
         }
@@ -219,16 +229,27 @@ struct Recorder {
         }
     }
 
-    void end(uint64_t k_, bigint start, bigint step)
+    // ``moved``: its atom left this rank (a build under MPI; the contact may go on elsewhere).
+    void end(uint64_t k_, bigint start, bigint step, bool moved = false)
     {
         if (!primed) return;
         const uint64_t lo = k_ >> 31, hi = k_ & ((uint64_t(1) << 31) - 1);
         const bool wall = hi >= (uint64_t(1) << 30);
         const double none[3] = {0, 0, 0};
-        const bool imposed = !targets.empty() && impose(k_);
+        const bool imposed = !moved && !targets.empty() && impose(k_);
         event(wall ? WALL_END : PAIR_END, step, double(lo), double(hi), 0.0, none, double(step - start), NAN, NAN,
-              imposed ? 1.0 : 0.0);
+              (imposed ? IMPOSED : 0.0) + (moved ? MOVED : 0.0));
         ++ended;
+    }
+
+    // Whether the atom of this id is one of this rank's own (a deleted atom's id may lie beyond
+    // LIGGGHTS' map).
+    bool local(tagint id) const
+    {
+        Atom *atom = lmp->atom;
+        if (id < 1 || id > atom->map_tag_max) return false;
+        const int m = atom->map(id);
+        return m >= 0 && m < atom->nlocal;
     }
 
     // The separation speed asked for contact k_ (if the host gave one) imposed now on the normal
@@ -243,8 +264,8 @@ struct Recorder {
         Atom *atom = lmp->atom;
         const tagint lo = tagint(k_ >> 31), hi = tagint(k_ & ((uint64_t(1) << 31) - 1));
         const bool wall = hi >= (tagint(1) << 30);
+        if (!local(lo) || (!wall && !local(hi))) return false;
         const int a = atom->map(lo), b = wall ? -1 : atom->map(hi);
-        if (a < 0 || a >= atom->nlocal || (!wall && (b < 0 || b >= atom->nlocal))) return false;
         double **x = atom->x, **v = atom->v;
         const double *m = atom->rmass;
         double n[3] = {t.n[0], t.n[1], t.n[2]};
@@ -308,7 +329,11 @@ struct Recorder {
             tagint top = max_tag;
             for (int i = 0; i < nlocal; ++i)
                 if (tag[i] > max_tag) {
-                    if (primed && max_tag >= 0) { appeared.push_back(double(tag[i])); appeared.push_back(conduction->Temp[i]); }
+                    if (primed && max_tag >= 0) {
+                        appeared.push_back(double(tag[i]));
+                        appeared.push_back(conduction->Temp[i]);
+                        appeared.push_back(double(step));
+                    }
                     top = std::max(top, tag[i]);
                 }
             max_tag = top;
@@ -436,7 +461,7 @@ struct Recorder {
         }
         if (rebuilt) {                         // contacts of the old layout not found again: ended
             for (const auto &c : carry) {
-                end(c.first, c.second.first, step);
+                end(c.first, c.second.first, step, lmp->comm->nprocs > 1 && !local(tagint(c.first >> 31)));
                 if (c.second.second >= 0) close_history(c.second.second);
             }
             carry.clear();
@@ -579,15 +604,15 @@ int collheat_events_take_histories(void *handle, double *out, int n)
 }
 
 // Atoms that appeared since the last call (with heat/gran): their number; with out, copy their
-// id and Temp at their first step (2 doubles each, up to n) and forget them.
+// id, Temp at their first step and that step (3 doubles each, up to n) and forget them.
 int collheat_events_appeared(void *handle, double *out, int n)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
-    const int have = int(rec->appeared.size() / 2);
+    const int have = int(rec->appeared.size() / 3);
     if (!out) return have;
     n = std::min(n, have);
-    std::memcpy(out, rec->appeared.data(), sizeof(double) * 2 * n);
-    rec->appeared.erase(rec->appeared.begin(), rec->appeared.begin() + 2 * n);
+    std::memcpy(out, rec->appeared.data(), sizeof(double) * 3 * n);
+    rec->appeared.erase(rec->appeared.begin(), rec->appeared.begin() + 3 * n);
     return n;
 }
 
@@ -602,6 +627,15 @@ void collheat_events_restitution(void *handle, int n, const int64_t *keys, const
         for (int c = 0; c < 3; ++c) t.n[c] = normal[3 * k + c];
         rec->targets[uint64_t(keys[k])] = t;
     }
+}
+
+// Forget the separation speeds of n contacts (keys) the host saw end: under MPI every rank
+// keeps every speed given (a contact may move to another rank), and only the rank where the
+// contact ended used its own.
+void collheat_events_forget(void *handle, int n, const int64_t *keys)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    for (int k = 0; k < n; ++k) rec->targets.erase(uint64_t(keys[k]));
 }
 
 // Events waiting, open contacts now, and all BEGIN and END events recorded so far.

@@ -190,13 +190,6 @@ class Dem:
             raise ScriptError(f"run {steps}{' upto' if upto else ''}: {why} (LIGGGHTS: 'Invalid run command')")
         return n
 
-    def events_possible(self) -> bool:
-        """Whether the contact events can stand for samples of the pair contacts: serial (each
-        rank's own events are the issue on MPI). A fix heat/gran's conduction during a
-        collision is taken back from the recorder's flux histories (``HEAT_GRAN_WINDOW``); a
-        restitution feedback's separation speed is imposed by the recorder at the contact's end."""
-        return self.link is None
-
     def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
                 events: bool = False) -> list[str]:
         """What the host adds before the first run: the Temp property (if no fix heat/gran or
@@ -223,8 +216,8 @@ class Dem:
         for line in added:
             self.command(Command(line, "(host)", 0))
         if events:
-            from pyhost.engines.events import ContactEvents
-            self.events = ContactEvents(self.lmp)
+            from pyhost.engines.events import ContactEvents, RankEvents
+            self.events = ContactEvents(self.lmp) if self.link is None else RankEvents(self.lmp, self.link)
             if heat and self.info.heat_gran:
                 self.events.conduction(self.info.heat_gran, HEAT_GRAN_WINDOW)
         for which in ("pair_compute", "wall_compute"):

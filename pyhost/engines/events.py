@@ -15,6 +15,11 @@ own formula, in compiled code); ``histories()`` hands them over once full or end
 BEGIN carries T, the two temperatures [K] at its step (NaN without heat/gran; for a wall, the
 particle's and NaN). ``restitution(keys, speeds, normals)`` has the recorder impose those
 separation speeds at the step each contact ends (restitution feedback); the END says so.
+
+Under MPI (``RankEvents``) each rank records the contacts of its own atoms; rank 0 orders the
+others and joins their batches (events only, a few per collision: no atoms, no contacts).
+A contact whose atom moves to another rank at a neighbour build ends there and begins on the
+new rank at the same step, both rows flagged ``moved``; :func:`join_moved` drops such pairs.
 """
 from __future__ import annotations
 
@@ -22,11 +27,14 @@ import ctypes
 
 import numpy as np
 
+from pyhost.engines.ranks import collective
+
 FIX = "collheat_events"
 ROW = 12
 BEGIN, END = 0, 1
 EVENT = np.dtype([("kind", np.int8), ("wall", np.bool_), ("step", np.int64), ("i", np.int64), ("j", np.int64),
-                  ("vn", float), ("n", float, 3), ("duration", np.int64), ("T", float, 2), ("imposed", np.bool_)])
+                  ("vn", float), ("n", float, 3), ("duration", np.int64), ("T", float, 2), ("imposed", np.bool_),
+                  ("moved", np.bool_)])
 
 _c = ctypes
 _vp, _int, _dp = _c.c_void_p, _c.c_int, _c.POINTER(_c.c_double)
@@ -47,13 +55,15 @@ _DECLARATIONS = {
     "collheat_events_appeared": (_int, [_vp, _dp, _int]),
     "collheat_events_cylinders": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp, _dp, _dp]),
     "collheat_events_restitution": (None, [_vp, _int, _c.POINTER(_c.c_int64), _dp, _dp]),
+    "collheat_events_forget": (None, [_vp, _int, _c.POINTER(_c.c_int64)]),
 }
+IMPOSED, MOVED = 1, 2      # the flags column
 HEAD = 4
 
 
 class ContactEvents:
-    """The contact events of one LIGGGHTS instance (``pyhost.engines.liggghts.Liggghts``),
-    serial. Create it before the run whose contacts it should follow: the contacts present at
+    """The contact events of one LIGGGHTS instance (``pyhost.engines.liggghts.Liggghts``):
+    serially all, under MPI this rank's (see :class:`RankEvents`). Create it before the run whose contacts it should follow: the contacts present at
     that run's set-up are open contacts, not events (see :meth:`prime`)."""
 
     def __init__(self, lmp, fix: str = FIX):
@@ -67,6 +77,7 @@ class ContactEvents:
         if not self.handle:
             raise RuntimeError(f"could not attach the contact event recorder to fix {fix}")
         self.window = 0
+        self.joined = []        # contacts that moved between ranks, at the last take (RankEvents)
 
     def conduction(self, fix: str, window: int) -> None:
         """Keep the flux [W] of ``fix <fix> ... heat/gran`` through each new pair contact at
@@ -76,14 +87,14 @@ class ContactEvents:
         self.window = int(window)
 
     def appeared(self) -> tuple:
-        """Atoms that appeared (inserted) since the last call, with heat/gran: ids and Temp [K]
-        at their first step, before heat/gran conducted any heat to them."""
+        """Atoms that appeared (inserted) since the last call, with heat/gran: ids, Temp [K]
+        at their first step, before heat/gran conducted any heat to them, and that step."""
         h = self.lmp.helper
         n = h.collheat_events_appeared(self.handle, None, 0) if self.window else 0
-        raw = np.empty((n, 2))
+        raw = np.empty((n, 3))
         if n:
             raw = raw[:h.collheat_events_appeared(self.handle, raw.ctypes.data_as(_dp), n)]
-        return raw[:, 0].astype(np.int64), raw[:, 1]
+        return raw[:, 0].astype(np.int64), raw[:, 1], raw[:, 2].astype(np.int64)
 
     def restitution(self, keys, speed, normal) -> None:
         """Separation speeds [m/s] to impose on open contacts (``pyhost.collisions.contact_keys``)
@@ -94,6 +105,12 @@ class ContactEvents:
         normal = np.ascontiguousarray(np.reshape(normal, (-1, 3)), dtype=float)
         self.lmp.helper.collheat_events_restitution(self.handle, len(keys), keys.ctypes.data_as(_c.POINTER(_c.c_int64)),
                                                     speed.ctypes.data_as(_dp), normal.ctypes.data_as(_dp))
+
+    def forget(self, keys) -> None:
+        """Drop the separation speeds of these contacts (they ended: under MPI the ranks where
+        they did not end keep theirs until told)."""
+        keys = np.ascontiguousarray(keys, dtype=np.int64)
+        self.lmp.helper.collheat_events_forget(self.handle, len(keys), keys.ctypes.data_as(_c.POINTER(_c.c_int64)))
 
     def histories(self, all: bool = False) -> tuple:
         """The flux histories handed over (with ``all``, also those still filling, which the
@@ -171,10 +188,130 @@ class ContactEvents:
         out["n"] = raw[:, 5:8]
         out["duration"] = raw[:, 8]
         out["T"] = raw[:, 9:11]
-        out["imposed"] = raw[:, 11] > 0
+        flags = raw[:, 11].astype(int)
+        out["imposed"] = (flags & IMPOSED) > 0
+        out["moved"] = (flags & MOVED) > 0
         return out
 
     def close(self) -> None:
         if self.handle:
             self.lmp.helper.collheat_events_free(self.handle)
             self.handle = None
+
+
+GATHERED = {"take", "histories", "appeared", "meshes", "waiting", "open_count", "totals"}
+"""What each rank answers to rank 0 (the others' recorders change only their own state)."""
+
+
+def ask(events, name: str, args=()):
+    """One rank's recorder does ``name`` (a method, or a property without ``args``)."""
+    value = getattr(events, name)
+    return value(*args) if callable(value) else value
+
+
+def join_moved(ev: np.ndarray) -> np.ndarray:
+    """All ranks' events of one harvest, with the contacts that moved between ranks joined: an
+    END flagged ``moved`` (its atom left the rank at a neighbour build) and a BEGIN flagged
+    ``moved`` (new on a rank at a build) of the same contact at the same step are one open
+    contact going on, and both go. What is left of either is a real END (the contact ended as
+    its atom left) or BEGIN (it began at the build). Returns the events, oldest first (by
+    step; the ranks' order within a step), flags cleared, and the joined ones as ``(key, step
+    it began, step it moved)`` rows (the flux histories use them)."""
+    from pyhost.collisions import contact_keys
+    moved = np.flatnonzero(ev["moved"])
+    drop = np.zeros(len(ev), bool)
+    joined = []
+    if len(moved):
+        keys = contact_keys(ev["i"][moved], ev["j"][moved])
+        ends = {}
+        for r, k in zip(moved.tolist(), keys.tolist()):
+            if ev["kind"][r] == END:
+                ends[k, int(ev["step"][r])] = r
+        for r, k in zip(moved.tolist(), keys.tolist()):
+            e = ends.get((k, int(ev["step"][r]))) if ev["kind"][r] == BEGIN else None
+            if e is not None:
+                drop[[r, e]] = True
+                step = int(ev["step"][r])
+                joined.append((k, step - int(ev["duration"][e]), step))
+    out = ev[~drop]
+    out["moved"] = False
+    return out[np.argsort(out["step"], kind="stable")], joined
+
+
+class RankEvents:
+    """Rank 0's recorder under MPI: every rank's own :class:`ContactEvents` (each records the
+    contacts of its atoms, in compiled code), ordered through the link
+    (``pyhost.engines.ranks.Link``); what rank 0 asks of them is joined here, events and flux
+    histories only. The interface is ContactEvents'."""
+
+    def __init__(self, lmp, link, fix: str = FIX):
+        self.link, self.joined = link, []
+        link.order("events", "attach", (fix,))
+        self.local = ContactEvents(lmp, fix)
+
+    @property
+    def window(self) -> int:
+        return self.local.window
+
+    @collective
+    def _all(self, name: str, *args):
+        """Every rank does it; rank 0's answer, and with GATHERED all ranks' in rank order."""
+        self.link.order("events", name, args)
+        mine = ask(self.local, name, args)
+        return self.link.gather(mine) if name in GATHERED else mine
+
+    def conduction(self, fix: str, window: int) -> None:
+        self._all("conduction", fix, window)
+
+    def planes(self, *args) -> None:
+        self._all("planes", *[list(a) for a in args])
+
+    def cylinders(self, *args) -> None:
+        self._all("cylinders", *[list(a) for a in args])
+
+    def meshes(self, ids, codes) -> bool:
+        return all(self._all("meshes", list(ids), list(codes)))
+
+    def prime(self) -> None:
+        self._all("prime")
+
+    def sync(self) -> None:
+        self._all("sync")
+
+    def restitution(self, keys, speed, normal) -> None:
+        self._all("restitution", np.asarray(keys), np.asarray(speed), np.asarray(normal))
+
+    def forget(self, keys) -> None:
+        self._all("forget", np.asarray(keys))
+
+    @property
+    def waiting(self) -> int:
+        return sum(self._all("waiting"))
+
+    @property
+    def open_count(self) -> int:
+        return sum(self._all("open_count"))
+
+    def totals(self) -> tuple[int, int]:
+        parts = self._all("totals")
+        return sum(p[0] for p in parts), sum(p[1] for p in parts)
+
+    def take(self) -> np.ndarray:
+        ev, self.joined = join_moved(np.concatenate(self._all("take")))
+        return ev
+
+    def histories(self, all: bool = False) -> tuple:
+        parts = self._all("histories", all)
+        return tuple(np.concatenate([p[k] for p in parts]) for k in range(5))
+
+    def appeared(self) -> tuple:
+        """As ContactEvents.appeared, each atom once: at the first step any rank saw it (one
+        that moved to a rank that had not seen so large an id appears there again, later)."""
+        parts = self._all("appeared")
+        ids, T, step = (np.concatenate([p[k] for p in parts]) for k in range(3))
+        order = np.lexsort((step, ids))
+        first = order[np.r_[True, ids[order][1:] != ids[order][:-1]]] if len(ids) else order
+        return ids[first], T[first], step[first]
+
+    def close(self) -> None:
+        self.local.close()          # the other ranks' go with their LIGGGHTS

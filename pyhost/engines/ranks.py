@@ -252,5 +252,15 @@ class Follower:
     def do_put(self, ids, arrays) -> None:
         put_by_id(self.lmp, ids, arrays)
 
+    def do_events(self, name, args) -> None:
+        """This rank's contact event recorder (pyhost.engines.events.RankEvents)."""
+        from pyhost.engines.events import GATHERED, ContactEvents, ask
+        if name == "attach":
+            self.events = ContactEvents(self.lmp, *args)
+            return
+        mine = ask(self.events, name, args)
+        if name in GATHERED:
+            self.comm.gather(mine, root=ROOT)
+
     def do_write(self, force_fix) -> None:
         write_local(self.lmp, *self.comm.scatter(None, root=ROOT), force_fix=force_fix)
