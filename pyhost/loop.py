@@ -115,6 +115,7 @@ class Coupling:
                            heat_convected=0.0, heat_convected_gross=0.0)
         self.CT_by_id = np.zeros(0)      # m c T of each id at its last sample [J] (energy balance)
         self.M_by_id = np.zeros(0)       # mass of each id at its last sample [kg] (0: not known)
+        self.T_first_by_id = np.zeros(0)  # temperature each id came in with [K] (the frames' change)
         self.seen = np.zeros(0, bool)
         self.warned = set()
         self.heat = self.effects["particle_temperatures"]
@@ -272,7 +273,7 @@ class Coupling:
                       randoms=self.dem.random_states())
         atoms = self.dem.atoms(self.heat)
         arrays = dict(open_keys=self.tracker.open_keys, contact_info=self.info, CT_by_id=self.CT_by_id,
-                      seen=self.seen, M_by_id=self.M_by_id, fluid_ids=self.fluid_force[0],
+                      seen=self.seen, M_by_id=self.M_by_id, T_first_by_id=self.T_first_by_id, fluid_ids=self.fluid_force[0],
                       fluid_force=self.fluid_force[1], T_ids=atoms.id,
                       T=atoms.T if self.heat else np.zeros(0),
                       target_keys=np.array(list(self.targets), np.int64),
@@ -289,6 +290,7 @@ class Coupling:
         self.info = np.asarray(state["contact_info"], float).reshape(-1, len(OPEN_COLUMNS))
         self.CT_by_id, self.seen = state["CT_by_id"], state["seen"]
         self.M_by_id = state.get("M_by_id", np.zeros(len(self.seen)))
+        self.T_first_by_id = state.get("T_first_by_id", np.full(len(self.seen), np.nan))
         self.totals.setdefault("energy_mass_change", 0.0)
         self.totals.setdefault("outside_model_range", 0)
         checkpoint.restore_forces(self.dem, state)
@@ -332,6 +334,7 @@ class Coupling:
             self.seen = np.r_[self.seen, np.zeros(grow, bool)]
             self.CT_by_id = np.r_[self.CT_by_id, np.zeros(grow)]
             self.M_by_id = np.r_[self.M_by_id, np.zeros(grow)]
+            self.T_first_by_id = np.r_[self.T_first_by_id, np.full(grow, np.nan)]
         mat = self.materials_of(atoms.type)
         C = atoms.mass * self.capacity[mat]
         new = ~self.seen[ids]
@@ -358,6 +361,7 @@ class Coupling:
                 self.check_densities(atoms, new, mat)
             self.totals["inserted"] += int(new.sum())
             self.totals["energy_in"] += float(np.sum(C[new] * T_entry))
+            self.T_first_by_id[ids[new]] = T_entry
         old = ~new & (self.M_by_id[ids] > 0)
         dm = atoms.mass[old] - self.M_by_id[ids[old]]
         if dm.any():
@@ -805,8 +809,9 @@ class Coupling:
                             + (self.bed_state(atoms) if self.fluid is not None else ())
                             + (self.gas_state() if self.convection else ())])
         if self.frames is not None:
+            change = T - self.T_first_by_id[atoms.id] if self.heat else T
             self.frames.write(self.t, atoms.x, id=atoms.id, type=atoms.type, radius=atoms.radius,
-                              velocity=atoms.v, temperature=T)
+                              velocity=atoms.v, temperature=T, temperature_change=change)
         if self.fluid_frames is not None:
             p, u = self.fluid.fields()
             self.fluid_frames.write(self.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)

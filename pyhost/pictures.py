@@ -48,11 +48,15 @@ def _group_names(out: Path) -> list:
         return []
 
 
-def temperature_change(pvd: Path):
-    """Each particle's temperature change [K] in the last frame of a particle series since the
-    first frame it appears in (so inserted particles start from their own first value)."""
+def temperature_change(pvd: Path, last=None):
+    """Each particle's temperature change [K] in the last frame of a particle series: the
+    frame's own ``temperature_change`` (since the particle came in, as the run knew it), or
+    for a series written without it, since the first frame the particle appears in (each frame
+    read: seconds for thousands of frames). ``last``: the last frame, if read already."""
     import pyvista
 
+    if last is not None and "temperature_change" in last.point_data:
+        return np.asarray(last.point_data["temperature_change"])
     reader = pyvista.get_reader(str(pvd))
     first = {}
     for time in reader.time_values:
@@ -142,7 +146,7 @@ def render_particles(out: Path) -> Path:
 
     pyvista.OFF_SCREEN = True
     cloud, t = _frame(out / "vtk" / "particles.pvd")
-    dT = temperature_change(out / "vtk" / "particles.pvd")
+    dT = temperature_change(out / "vtk" / "particles.pvd", cloud)
     factor, unit, clim = change_scale(dT)
     cloud.point_data["change"] = dT * factor
     spheres = cloud.glyph(geom=pyvista.Sphere(theta_resolution=12, phi_resolution=12), scale="radius",

@@ -26,3 +26,12 @@ def run(args) -> int:
         made.append(render_particles(args.out))
     print("pictures:", *made)
     return 0
+
+
+if __name__ == "__main__":      # what `run` starts: the same, without building every command's parser
+    import sys
+    from pyhost.cli import UserError
+    try:
+        sys.exit(run(argparse.Namespace(out=Path(sys.argv[1]))))
+    except UserError as exc:
+        sys.exit(f"error: {exc}")

@@ -308,7 +308,7 @@ def run_case(args, link) -> int:
     summary = simulate(scene, out, test=args.test, resume=resume, link=link)
     print("summary:", json.dumps(summary, indent=1))
     if scene.output.pictures:        # own process: see pyhost/commands/pictures.py
-        drawn = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(out)])
+        drawn = subprocess.run([sys.executable, "-m", "pyhost.commands.pictures", str(out)])
         if drawn.returncode != 0:
             print(f"warning: pictures failed (exit {drawn.returncode}); the run's data are in {out}")
     return 0

@@ -46,6 +46,10 @@ def test_two_particles_match_plugin(tmp_path):
     T = last_frame(tmp_path).point_data["temperature"]
     C = 4 / 3 * math.pi * 2e-3**3 * 7800 * 470
     assert (400 - T[0]) * C == pytest.approx(ref.Q, rel=0.01)
+    # each frame's change since the particle came in (400 K and 300 K): what particles.png colours
+    change = last_frame(tmp_path).point_data["temperature_change"]
+    assert change == pytest.approx(T - [400.0, 300.0], abs=1e-9)
+    assert change[0] < 0 < change[1] and change[0] == pytest.approx(-change[1], rel=1e-9)
 
 
 def test_wall_impact_matches_plugin_and_balances(tmp_path):
