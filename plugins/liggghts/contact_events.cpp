@@ -49,6 +49,7 @@
 #include "neighbor.h"
 #include "fix_mesh_surface.h"
 #include "fix_neighlist_mesh.h"
+#include "fix_contact_history_mesh.h"
 #include "tri_mesh.h"
 #include "domain.h"
 #include "fix_property_atom.h"
@@ -87,10 +88,11 @@ struct Recorder {
     std::vector<double> cyl_radius, cyl_c1, cyl_c2, cyl_code;   // two other coordinates [m], code
     std::vector<FixMeshSurface *> meshes;       // mesh walls: the fix mesh/surface and the code
     std::vector<double> mesh_code;             // of its contacts (one per particle and mesh: the deepest)
-    std::vector<double> depth, normal;         // per mesh and local atom, this call: overlap [m] and normal,
-    std::vector<int> deepest;                  // and the deepest triangle
+    std::vector<double> depth, normal;         // per local atom, this call and mesh: overlap [m] and normal,
+    std::vector<int> deepest;                  // and the deepest triangle (meshes without a contact history)
     bool new_planes = false;                   // planes given since the last call: what touches them is open
     long long begun = 0, ended = 0;
+    int meshes_by_history = 0;                 // meshes read from LIGGGHTS' contact history at the last call
     struct Target { double speed, n[3]; };     // separation speed [m/s] to impose at the end; a wall's normal
     std::unordered_map<uint64_t, Target> targets;
     FixHeatGranCond *conduction = nullptr;     // a script's fix heat/gran, or none
@@ -287,6 +289,59 @@ struct Recorder {
         return true;
     }
 
+    // Particle p (local) against triangle t: true if they touch (LIGGGHTS' test), with the
+    // overlap dn < 0 [m] and the unit normal from the wall to the particle.
+    bool tri_contact(TriMesh *mesh, int p, int t, double &dn, double *n) const
+    {
+        double **x = lmp->atom->x;
+        double delta[3];
+        int barysign;
+        dn = mesh->resolveTriSphereContact(p, t, lmp->atom->radius[p], x[p], delta, barysign);
+        if (dn >= 0) return false;
+        double node0[3];
+        mesh->node(t, 0, node0);
+        const double len = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
+        double s = len > 0 ? 1.0 / len : 0.0;
+        if ((x[p][0] - node0[0]) * delta[0] + (x[p][1] - node0[1]) * delta[1] + (x[p][2] - node0[2]) * delta[2] < 0)
+            s = -s;
+        n[0] = delta[0] * s; n[1] = delta[1] * s; n[2] = delta[2] * s;
+        return true;
+    }
+
+    // Slot k: particle i touching mesh m, deepest on triangle t with normal n: the approach
+    // speed relative to the wall at the contact point.
+    void begin_on_mesh(size_t k, bigint step, bool rebuilt, size_t m, TriMesh *mesh, int i, int t, const double *n)
+    {
+        double **x = lmp->atom->x, **v = lmp->atom->v;
+        double vw[3] = {0, 0, 0};
+        MultiVectorContainer<double, 3, 3> *moving = mesh->prop().getElementProperty<MultiVectorContainer<double, 3, 3> >("v");
+        if (moving) {
+            double point[3], bary[3];
+            int barysign;
+            mesh->resolveTriSphereContactBary(i, t, lmp->atom->radius[i], x[i], point, bary, barysign);
+            double ***node_v = moving->begin();
+            for (int c = 0; c < 3; ++c)
+                vw[c] = bary[0] * node_v[t][0][c] + bary[1] * node_v[t][1][c] + bary[2] * node_v[t][2][c];
+        }
+        const double vn = -((v[i][0] - vw[0]) * n[0] + (v[i][1] - vw[1]) * n[1] + (v[i][2] - vw[2]) * n[2]);
+        const int *tag = lmp->atom->tag;
+        on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]), tag[i], mesh_code[m],
+           i, -1, vn, n, new_planes);
+    }
+
+    // Whether every fix wall/gran comes before this fix: their post_force (and the mesh
+    // contact histories it keeps) ran this step before the recorder's.
+    bool walls_before_me() const
+    {
+        const Modify *modify = lmp->modify;
+        int me = -1, last_wall = -1;
+        for (int f = 0; f < modify->nfix; ++f) {
+            if (modify->fix[f] == fix) me = f;
+            else if (std::strncmp(modify->fix[f]->style, "wall/gran", 9) == 0) last_wall = f;
+        }
+        return me > last_wall;
+    }
+
     void record(bigint step)
     {
         Atom *atom = lmp->atom;
@@ -402,61 +457,72 @@ struct Recorder {
                    i, -1, -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]), n, new_planes);
             }
         }
-        // mesh walls: LIGGGHTS' own candidates of each triangle and its own contact test
-        // (TriMesh::resolveTriSphereContact: distance - radius < 0), the deepest triangle
-        // giving the normal, turned to point from the wall to the particle. A moving mesh
-        // (fix move/mesh) gives the wall's velocity at the contact point, as fix wall/gran
+        // mesh walls. Where LIGGGHTS keeps a contact history of the mesh (fix wall/gran with
+        // tangential history) and its wall/gran fixes come before this fix (their post_force
+        // ran this step), the particles in contact are those with a partner triangle there
+        // (fix wall/gran's own test, deltan <= 0, kept by FixContactHistoryMesh): one integer
+        // per particle and step, and the geometry only for a contact that begins. Otherwise
+        // LIGGGHTS' own candidates of each triangle and its own contact test
+        // (TriMesh::resolveTriSphereContact: distance - radius < 0). Either way the deepest
+        // triangle gives the normal, turned to point from the wall to the particle. A moving
+        // mesh (fix move/mesh) gives the wall's velocity at the contact point, as fix wall/gran
         // takes it: its triangle's node velocities weighted by the point's barycentric
         // coordinates; the approach speed is the relative one.
-        if (!meshes.empty()) {
-            depth.assign(meshes.size() * size_t(nlocal), 0.0);
-            normal.resize(3 * meshes.size() * size_t(nlocal));
-            deepest.resize(meshes.size() * size_t(nlocal));
-        }
+        const bool walls_first = !meshes.empty() && walls_before_me();
+        meshes_by_history = 0;
         for (size_t m = 0; m < meshes.size(); ++m) {
             TriMesh *mesh = meshes[m]->triMesh();
             FixNeighlistMesh *near = meshes[m]->meshNeighlist();
+            FixContactHistoryMesh *hist = meshes[m]->contactHistory();
             if (!near) continue;
+            if (walls_first && hist && lmp->neighbor->contactDistanceFactor <= 1.0) {
+                ++meshes_by_history;
+                for (int i = 0; i < nlocal; ++i, ++k) {
+                    if (hist->n_partner(i) == 0) { off(k, step, rebuilt); continue; }
+                    if (touch[k] && !rebuilt) continue;
+                    const uint64_t key_ = (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]);
+                    const double zero[3] = {0, 0, 0};
+                    if (rebuilt && carry.count(key_)) {             // open before the build
+                        on(k, step, rebuilt, WALL_BEGIN, key_, tag[i], mesh_code[m], i, -1, 0.0, zero);
+                        continue;
+                    }
+                    double best = 0, n[3] = {0, 0, 0};
+                    int t_best = -1;
+                    for (int j = 0; j < hist->nneighs(i); ++j) {
+                        const int id = hist->get_partner_idTri(i, j);
+                        if (id < 0) continue;
+                        for (int c = 0; c < mesh->map_size(id); ++c) {
+                            const int t = mesh->map(id, c);
+                            if (t < 0) continue;
+                            double dn, nt[3];
+                            if (!tri_contact(mesh, i, t, dn, nt)) continue;
+                            if (t_best < 0 || dn < best) { best = dn; t_best = t; n[0] = nt[0]; n[1] = nt[1]; n[2] = nt[2]; }
+                            break;
+                        }
+                    }
+                    if (t_best < 0) { off(k, step, rebuilt); continue; }    // (a partner LIGGGHTS has not cleaned up)
+                    begin_on_mesh(k, step, rebuilt, m, mesh, i, t_best, n);
+                }
+                continue;
+            }
+            if (depth.size() < size_t(nlocal)) { depth.resize(nlocal); normal.resize(3 * size_t(nlocal)); deepest.resize(nlocal); }
+            std::fill(depth.begin(), depth.begin() + nlocal, 0.0);
             const int ntri = mesh->sizeLocal() + mesh->sizeGhost();
             for (int t = 0; t < ntri; ++t) {
                 const std::vector<int> &cand = near->get_contact_list(t);
                 for (int p : cand) {
                     if (p >= nlocal) continue;
-                    double delta[3];
-                    int barysign;
-                    const double dn = mesh->resolveTriSphereContact(p, t, r[p], x[p], delta, barysign);
-                    double &best = depth[m * nlocal + p];
-                    if (dn >= 0 || dn >= best) continue;
-                    best = dn;
-                    deepest[m * nlocal + p] = t;
-                    double node0[3];
-                    mesh->node(t, 0, node0);
-                    const double len = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
-                    double s = len > 0 ? 1.0 / len : 0.0;
-                    if ((x[p][0] - node0[0]) * delta[0] + (x[p][1] - node0[1]) * delta[1] + (x[p][2] - node0[2]) * delta[2] < 0)
-                        s = -s;
-                    double *n = &normal[3 * (m * nlocal + p)];
-                    n[0] = delta[0] * s; n[1] = delta[1] * s; n[2] = delta[2] * s;
+                    double dn, nt[3];
+                    if (!tri_contact(mesh, p, t, dn, nt) || dn >= depth[p]) continue;
+                    depth[p] = dn;
+                    deepest[p] = t;
+                    normal[3 * p] = nt[0]; normal[3 * p + 1] = nt[1]; normal[3 * p + 2] = nt[2];
                 }
             }
-            MultiVectorContainer<double, 3, 3> *moving = mesh->prop().getElementProperty<MultiVectorContainer<double, 3, 3> >("v");
             for (int i = 0; i < nlocal; ++i, ++k) {
-                if (depth[m * nlocal + i] >= 0) { off(k, step, rebuilt); continue; }
+                if (depth[i] >= 0) { off(k, step, rebuilt); continue; }
                 if (touch[k] && !rebuilt) continue;
-                const double *n = &normal[3 * (m * nlocal + i)];
-                double vw[3] = {0, 0, 0};
-                if (moving) {
-                    const int t = deepest[m * nlocal + i];
-                    double point[3], bary[3];
-                    int barysign;
-                    mesh->resolveTriSphereContactBary(i, t, r[i], x[i], point, bary, barysign);
-                    double ***node_v = moving->begin();
-                    for (int c = 0; c < 3; ++c)
-                        vw[c] = bary[0] * node_v[t][0][c] + bary[1] * node_v[t][1][c] + bary[2] * node_v[t][2][c];
-                }
-                const double vn = -((v[i][0] - vw[0]) * n[0] + (v[i][1] - vw[1]) * n[1] + (v[i][2] - vw[2]) * n[2]);
-                on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]), tag[i], mesh_code[m],
-                   i, -1, vn, n, new_planes);
+                begin_on_mesh(k, step, rebuilt, m, mesh, i, deepest[i], &normal[3 * i]);
             }
         }
         if (rebuilt) {                         // contacts of the old layout not found again: ended
@@ -637,6 +703,9 @@ void collheat_events_forget(void *handle, int n, const int64_t *keys)
     Recorder *rec = static_cast<Recorder *>(handle);
     for (int k = 0; k < n; ++k) rec->targets.erase(uint64_t(keys[k]));
 }
+
+// How many mesh walls the last call read from LIGGGHTS' mesh contact history (the others by geometry).
+int collheat_events_meshes_by_history(void *handle) { return static_cast<Recorder *>(handle)->meshes_by_history; }
 
 // Events waiting, open contacts now, and all BEGIN and END events recorded so far.
 int collheat_events_waiting(void *handle) { return int(static_cast<Recorder *>(handle)->rows.size() / ROW); }

@@ -56,6 +56,7 @@ _DECLARATIONS = {
     "collheat_events_cylinders": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp, _dp, _dp]),
     "collheat_events_restitution": (None, [_vp, _int, _c.POINTER(_c.c_int64), _dp, _dp]),
     "collheat_events_forget": (None, [_vp, _int, _c.POINTER(_c.c_int64)]),
+    "collheat_events_meshes_by_history": (_int, [_vp]),
 }
 IMPOSED, MOVED = 1, 2      # the flags column
 HEAD = 4
@@ -147,6 +148,13 @@ class ContactEvents:
         arr = (_c.c_char_p * len(ids))(*[i.encode() for i in ids])
         codes = np.ascontiguousarray(codes, dtype=float)
         return self.lmp.helper.collheat_events_meshes(self.handle, len(ids), arr, codes.ctypes.data_as(_dp)) >= 0
+
+    @property
+    def meshes_by_history(self) -> int:
+        """Mesh walls whose contacts the last step read from LIGGGHTS' own mesh contact history
+        (fix wall/gran with tangential history, defined before the recorder's fix); the others
+        are found by the recorder's own sphere-triangle test."""
+        return self.lmp.helper.collheat_events_meshes_by_history(self.handle)
 
     def prime(self) -> None:
         """The next step records the contacts there as open, without events (a (re)start)."""

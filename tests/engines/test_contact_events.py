@@ -228,27 +228,37 @@ endsolid floor
 """
 
 
-def test_mesh_wall_events_follow_liggghts_own_wall_contact_list(tmp_path):
+def pour_on_floor(stl) -> str:
+    """60 spheres of 1 mm radius at rest in the box, falling onto the STL floor at z = -0.01 m."""
+    return f"""
+        fix gravi all gravity 9.81 vector 0 0 -1
+        fix cad all mesh/surface file {stl} type 1
+        fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad
+        region fill block -0.008 0.008 -0.008 0.008 -0.006 0.009 units box
+        fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
+        fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+        fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 0 insert_every once overlapcheck yes all_in yes particles_in_region 60 region fill
+        fix integrate all nve/sphere
+    """
+
+
+@pytest.mark.parametrize("recorder_first", [False, True])
+def test_mesh_wall_events_follow_liggghts_own_wall_contact_list(tmp_path, recorder_first):
     """Spheres poured onto an STL floor (two triangles): a sphere meets it at the free-fall
     speed, and at every step the particles that begin and end touching the mesh are exactly
-    those compute wall/gran/local gains and loses (a particle on both triangles is one contact)."""
+    those compute wall/gran/local gains and loses (a particle on both triangles is one contact).
+    Both ways the recorder finds them: from fix wall/gran's own mesh contact history (the wall
+    fix before the recorder's) and by its own sphere-triangle test (the wall fix after it)."""
     (tmp_path / "floor.stl").write_text(FLOOR)
     with box(tmp_path, dt=1e-5) as lg:
-        lg.commands(f"""
-            fix gravi all gravity 9.81 vector 0 0 -1
-            fix cad all mesh/surface file {tmp_path / 'floor.stl'} type 1
-            fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad
-            region fill block -0.008 0.008 -0.008 0.008 -0.006 0.009 units box
-            fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
-            fix pdd all particledistribution/discrete 15485867 1 pts 1.0
-            fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 0 insert_every once overlapcheck yes all_in yes particles_in_region 60 region fill
-            fix integrate all nve/sphere
-        """)
+        ev = ContactEvents(lg) if recorder_first else None
+        lg.commands(pour_on_floor(tmp_path / "floor.stl"))
         lg.add_wall_contacts()
-        ev = ContactEvents(lg)
+        ev = ev or ContactEvents(lg)
         lg.run(1)
         assert ev.meshes(["cad"], [WALL_BASE + 3])
         lg.run(1)
+        assert ev.meshes_by_history == (0 if recorder_first else 1)
         ev.take()
         z0 = {int(i): z for i, z in zip(lg.atom("id"), lg.atom("x")[:, 2])}
         # compute wall/gran/local 'vel id contactArea delta': ids are columns 6-8 (mesh, triangle,
