@@ -66,6 +66,7 @@ _HELPER_DECLARATIONS = {
     "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
     "collheat_move_mesh_time": (_int, [_vp, _cp, _c.POINTER(_c.c_double), _int]),
     "collheat_random_state": (_int, [_vp, _cp, _cp, _c.POINTER(_int), _int]),
+    "collheat_keep_mesh_bins": (_int, [_vp]),
 }
 
 # Per-atom arrays: name -> (ctype, columns; 0 for a vector).
@@ -260,6 +261,8 @@ class Liggghts:
         line = f"run {steps} post no" if self._changed else f"run {steps} pre no post no"
         if self._changed:       # the set-up is tried (bad input); what fails while stepping returns
             self._tried(lambda: self._call("run 0 post no"), line)
+        else:                   # mesh walls keep the bins of their triangles (plugins/liggghts/run_chunks.cpp)
+            self.helper.collheat_keep_mesh_bins(self.ptr)
         self._execute(line, LiggghtsFailed, what="during the run, at step {step}")
         self._changed = False
 
@@ -324,7 +327,7 @@ class Liggghts:
                 os.kill(pid, signal.SIGKILL)
                 return os.waitpid(pid, 0)[1]
             time.sleep(pause)
-            pause = min(2 * pause, 0.05)
+            pause = min(2 * pause, 0.005)     # (a 50 ms cap overslept up to twice a short trial)
 
     # -- per-atom data ----------------------------------------------------------------
     @property

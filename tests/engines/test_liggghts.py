@@ -171,3 +171,28 @@ def test_error_in_a_later_chunk_returns_with_liggghts_message(tmp_path):
         assert lg.atom("x").shape == (2, 3) and np.all(np.isfinite(lg.atom("x")))
         with pytest.raises(LiggghtsError, match="runs nothing more"):
             lg.run(1)
+
+
+def test_short_chunks_on_a_static_mesh_step_as_one_run(tmp_path):
+    """A pour onto an STL floor run as 1200 chunks of 5 steps (``run 5 pre no post no``, with
+    the mesh's triangle bins kept between chunks: plugins/liggghts/run_chunks.cpp) and as one
+    run of 6000 steps, the spheres landed: the same positions, bit for bit. LIGGGHTS itself would rebuild each
+    triangle's bins at every chunk (chute_wear: 19.4 s in 1,000 chunks against 12.5 s)."""
+    from test_contact_events import FLOOR, pour_on_floor
+    (tmp_path / "floor.stl").write_text(FLOOR)
+    positions, kept = [], []
+    for chunks in (1200, 1):
+        work = tmp_path / f"chunks{chunks}"
+        with Liggghts(work) as lg:
+            lg.commands(granular_box((-0.01,) * 3, (0.01,) * 3, youngs=5e6, poisson=0.3, restitution=0.5,
+                                     friction=0.5, skin=5e-4, dt=1e-5))
+            lg.commands(pour_on_floor(tmp_path / "floor.stl"))
+            lg.run(1)
+            for _ in range(chunks):
+                lg.run(6000 // chunks)
+            kept.append(lg.helper.collheat_keep_mesh_bins(lg.ptr))
+            order = np.argsort(lg.atom("id"))
+            positions.append(lg.atom("x")[order].copy())
+    assert kept == [1, 1]                               # the mesh's list was told to keep its bins
+    assert len(positions[0]) == 60 and positions[0][:, 2].min() < -0.0089   # (landed on the floor at z = -0.01)
+    assert np.array_equal(positions[0], positions[1])
