@@ -264,6 +264,9 @@ class Coupling:
     # -- checkpoint (pyhost.checkpoint writes and reads the files) ---------------------------
     def state(self) -> tuple[dict, dict]:
         """The host's state at the end of a step: (JSON values, arrays)."""
+        for series in (self.frames, self.fluid_frames):    # every frame it names on disk
+            if series is not None:
+                series.flush()
         logs = dict(collisions=self.collisions.mark(), history=self.history.mark(),
                     particles=self.frames.frames if self.frames is not None else None,
                     fluid=self.fluid_frames.frames if self.fluid_frames is not None else None)

@@ -1,3 +1,8 @@
+# Every VTK module of pyvista's wheel is loaded (and its symbols bound) before any test opens
+# LIGGGHTS in this process: Debian's libliggghts brings Debian's VTK 9.1 into the global
+# symbol scope, and a pip VTK module loaded after it bound some symbols there (a reader's
+# segfault in tests/unit/test_dumps.py after tests/engines/test_contact_events.py).
+import vtkmodules.all  # noqa: F401,E402
 import pytest
 
 from plugins.heat import Pair

@@ -4,6 +4,7 @@ import io
 import os
 import json
 
+import meshio
 import numpy as np
 import pytest
 import pyvista
@@ -171,3 +172,29 @@ def test_a_full_disk_names_the_log_it_was_writing(tmp_path):
         log.write([(0.5, 1)])
     code, message = classify(err.value)
     assert code == 2 and message == f"{tmp_path / 'collisions.csv'}: No space left on device"
+
+
+def test_frames_are_written_from_copies_while_the_caller_goes_on(tmp_path):
+    """A frame is written by a thread of its own: it holds the arrays as they were when given
+    (the caller's may be the engine's memory, changed by the next chunk)."""
+    series = VtkSeries(tmp_path, "p")
+    x = np.zeros((3, 3))
+    T = np.array([300.0, 310.0, 320.0])
+    series.write(0.0, x, temperature=T)
+    x += 1.0
+    T[:] = 0.0                                  # the engine's next chunk, while the frame is written
+    series.flush()
+    frame = meshio.read(tmp_path / "p_00000.vtu")
+    assert np.array_equal(frame.points, np.zeros((3, 3)))
+    assert np.array_equal(frame.point_data["temperature"], [300.0, 310.0, 320.0])
+
+
+def test_a_frame_that_cannot_be_written_fails_the_next_call(tmp_path):
+    """An error while a frame is written (here: its folder gone) is raised in the caller by
+    the index that follows (this write's own, the next write's or flush), not lost in the
+    writer's thread."""
+    series = VtkSeries(tmp_path / "vtk", "p")
+    (tmp_path / "vtk").rmdir()
+    with pytest.raises(FileNotFoundError, match="p_00000.vtu"):
+        series.write(0.0, np.zeros((1, 3)), temperature=np.ones(1))
+        series.flush()
