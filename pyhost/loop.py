@@ -212,7 +212,9 @@ class Coupling:
             step += chunk
             self.t = self.dem.step * self.dem.dt
             due = {name: k and step % k == 0 for name, k in self.every.items()}
-            if due["sample"] or (self.events and any(due.values())):
+            if self.events and self.harvest_alone(due):
+                self.harvest_partly()
+            elif due["sample"] or (self.events and any(due.values())):
                 atoms = self.dem.atoms(self.heat)
                 self.track_particles(atoms)
                 if self.events:
@@ -321,13 +323,15 @@ class Coupling:
                               "[materials.NAME] types = [...] list")
         return mat
 
-    def track_particles(self, atoms) -> None:
+    def track_particles(self, atoms, departures: bool = True) -> None:
         """Inserted particles: their material's temperature (if the scene gives one) and their
         heat content enters the balance; departed ones (deleted, lost) leave it with the heat
         content of their last sample; particles whose mass changed since their last sample
         (a script's fix adapt, set ... density) change their heat content by c dm T, the
         balance's ``energy_mass_change`` (at the current T: the heat the host moved in between
-        went in at the old mass's capacity, so the two add up to the change of m c T exactly)."""
+        went in at the old mass's capacity, so the two add up to the change of m c T exactly).
+        ``departures=False``: ``atoms`` are some of the particles (``harvest_partly``), the
+        absent ones have not departed."""
         if not self.heat:
             return
         ids = atoms.id
@@ -371,7 +375,7 @@ class Coupling:
             self.totals["energy_mass_change"] += float(np.sum(self.capacity[mat[old]] * dm * atoms.T[old]))
         present = np.zeros(len(self.seen), bool)
         present[ids] = True
-        gone = self.seen & ~present
+        gone = self.seen & ~present if departures else present[:0]
         if gone.any():
             self.totals["departed"] += int(gone.sum())
             self.totals["energy_out"] += float(self.CT_by_id[gone].sum())
@@ -484,7 +488,26 @@ class Coupling:
         return (wall, jl, mat, typ, np.where(wall, np.inf, atoms.radius[jj]),
                 np.where(wall, np.inf, atoms.mass[jj]))
 
-    def harvest(self, atoms, final: bool = False) -> None:
+    def harvest_alone(self, due) -> bool:
+        """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran:
+        then only the colliding atoms are gathered to rank 0 (``harvest_partly``). Nothing but
+        the host changes a temperature then, and each atom's heat content in the balance is
+        brought up to date when it is next seen."""
+        return (self.dem.link is not None and not self.dem.events.window and self.keep_all is None
+                and due["harvest"] and not any(v for k, v in due.items() if k != "harvest"))
+
+    def harvest_partly(self) -> None:
+        """A harvest under MPI for which rank 0 gathers only the atoms of the events (the
+        others stay on their ranks): ``harvest`` on them."""
+        ev = self.dem.events.take()
+        if not len(ev):
+            return
+        ids = np.unique(np.r_[ev["i"], ev["j"][~ev["wall"]]])
+        atoms = self.dem.atoms_of(ids, self.heat)
+        self.track_particles(atoms, departures=False)
+        self.harvest(atoms, ev=ev)
+
+    def harvest(self, atoms, final: bool = False, ev=None) -> None:
         """The contact events recorded inside LIGGGHTS since the last harvest: each begun
         contact is a collision, at its impact speed as recorded at first touch, its heat moved
         now in the order the collisions happened. Without a fix heat/gran nothing else changes
@@ -498,7 +521,7 @@ class Coupling:
         box) is counted apart (collisions_of_departed) and moves no heat: its heat content left
         at its last sample; so is one that began with no approach speed
         (contacts_without_impact)."""
-        ev = self.dem.events.take()
+        ev = self.dem.events.take() if ev is None else ev
         begin, ends = ev[ev["kind"] == BEGIN], ev[ev["kind"] == END]
         if self.dem.events.joined:               # open contacts that moved between ranks (MPI)
             self.totals["contacts_changed_rank"] = self.totals.get("contacts_changed_rank", 0) + len(self.dem.events.joined)

@@ -76,6 +76,21 @@ run 6000
 """
 
 
+def glass_toml(name: str = "glass", types: str = "[1]", temperature: str = "temperature = 300.0") -> str:
+    """A case.toml [materials.NAME] table of soda-lime glass (SI), for users' scripts whose
+    particles are glass beads of density 2500 kg/m^3."""
+    return f"""[materials.{name}]
+types = {types}
+{temperature}
+density = 2500.0
+youngs_modulus = 63e9
+poisson_ratio = 0.25
+yield_stress = 500e6
+heat_capacity = 840.0
+conductivity = 1.0
+"""
+
+
 @pytest.fixture(scope="session")
 def pour_dumps(tmp_path_factory):
     """Dumps of a 60-particle pour on Debian's LIGGGHTS (about 1 s): post/dump.* (one step a

@@ -27,8 +27,8 @@ import numpy as np
 
 from pyhost.collisions import WALL_BASE
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
-from pyhost.engines.ranks import (collective, gather_arrays, local_atoms, local_random_states, local_values, put_by_id,
-                                  set_random_states, write_local)
+from pyhost.engines.ranks import (collective, gather_arrays, local_atoms, local_atoms_of, local_random_states,
+                                  local_values, put_by_id, set_random_states, write_local)
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 
 FLUID_FIX = "collheat_fluid"
@@ -105,6 +105,7 @@ class Dem:
         self._warnings = set()    # LIGGGHTS warnings already shown
         self._pending = None      # under MPI: the last gathered atoms, their T and v as gathered
         self._counts = None       # under MPI: atoms per rank in the last gather
+        self._rows = None         # under MPI: rank 0's local indices sent in the last gather (None: all)
 
     def _order(self, name: str, *args) -> None:
         """Under MPI: what the host changed goes back to the ranks, then the followers make
@@ -270,11 +271,29 @@ class Dem:
             T = lmp.temperature() if temperature and lmp.nlocal else (np.zeros(0) if temperature else None)
             return Atoms(lmp.atom("id").astype(np.int64), lmp.atom("x"), lmp.atom("v"), lmp.atom("radius"),
                          lmp.atom("rmass"), lmp.atom("type"), T)
-        if self._pending is not None and (not temperature or self._pending[0].T is not None):
+        if self._pending is not None and self._rows is None and (not temperature or self._pending[0].T is not None):
             return self._pending[0]     # no run or command since: as serially, the same arrays
         self._order("atoms", temperature)
         cols, counts = gather_arrays(self.link.comm, local_atoms(lmp, temperature))
-        self._counts = np.array(counts)
+        self._counts, self._rows = np.array(counts), None
+        atoms = Atoms(cols[0].astype(np.int64), *cols[1:6], cols[6] if temperature else None)
+        self._pending = (atoms, None if atoms.T is None else atoms.T.copy(), atoms.v.copy())
+        return atoms
+
+    @collective
+    def atoms_of(self, ids, temperature: bool = True) -> Atoms:
+        """Under MPI: only the atoms of these ids (those that exist), gathered from the ranks
+        that own them (the ids go to every rank), in no particular order; what the loop
+        writes into their T and v goes back as with :meth:`atoms`. Serially, and while the
+        atoms gathered last are still current: all atoms, as :meth:`atoms`."""
+        if self.link is None or (self._pending is not None and self._rows is None
+                                 and (not temperature or self._pending[0].T is not None)):
+            return self.atoms(temperature)
+        self._commit()
+        self._order("atoms_of", np.asarray(ids, np.int64), temperature)
+        rows, parts = local_atoms_of(self.lmp, ids, temperature)
+        cols, counts = gather_arrays(self.link.comm, parts)
+        self._counts, self._rows = np.array(counts), rows
         atoms = Atoms(cols[0].astype(np.int64), *cols[1:6], cols[6] if temperature else None)
         self._pending = (atoms, None if atoms.T is None else atoms.T.copy(), atoms.v.copy())
         return atoms
@@ -300,7 +319,7 @@ class Dem:
         pieces = [np.split(arrays[k], cut) if arrays.get(k) is not None else [None] * len(self._counts)
                   for k in names]
         self.link.order("write", FLUID_FIX)
-        write_local(self.lmp, *self.link.scatter(list(zip(*pieces))), force_fix=FLUID_FIX)
+        write_local(self.lmp, *self.link.scatter(list(zip(*pieces))), force_fix=FLUID_FIX, rows=self._rows)
 
     @collective
     def per_atom(self, names) -> tuple:
@@ -371,6 +390,8 @@ class Dem:
             self.lmp.external_force(FLUID_FIX)[:] = force
             return
         self._commit()
+        if self._rows is not None:
+            raise RuntimeError("a force for every atom needs the atoms of atoms(), not of atoms_of()")
         if len(force) != self._counts.sum():
             raise ValueError(f"{len(force)} forces for {self._counts.sum()} particles")
         self._write(force=np.asarray(force, float))

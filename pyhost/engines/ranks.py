@@ -45,6 +45,14 @@ def local_atoms(lmp, temperature: bool) -> tuple:
     return tuple(parts)
 
 
+def local_atoms_of(lmp, ids, temperature: bool) -> tuple:
+    """Of these atom ids, those this rank owns: their local indices, and their rows as
+    :func:`local_atoms` gives them."""
+    here = lmp.atom("id").astype(np.int64)
+    rows = np.flatnonzero(np.isin(here, np.asarray(ids, np.int64)))
+    return rows, tuple(_plain(np.ascontiguousarray(a[rows])) for a in local_atoms(lmp, temperature))
+
+
 def _plain(a) -> np.ndarray:
     """A contiguous array whose buffer mpi4py knows: numpy's own format ('i', 'd'), not the
     explicit little-endian one ('<i', '<d') that arrays made from ctypes memory keep, copies
@@ -95,12 +103,14 @@ def put_by_id(lmp, ids, arrays: dict) -> None:
     lmp.keep_set_up()
 
 
-def write_local(lmp, T=None, v=None, force=None, force_fix: str | None = None) -> None:
-    """This rank's own slice of what the host changed, in the local order it sent."""
+def write_local(lmp, T=None, v=None, force=None, force_fix: str | None = None, rows=None) -> None:
+    """This rank's own slice of what the host changed, in the local order it sent (``rows``:
+    the local indices it sent, if it sent only some atoms)."""
+    at = slice(None) if rows is None else rows
     if T is not None and len(T):
-        lmp.temperature()[:] = T
+        lmp.temperature()[at] = T
     if v is not None and len(v):
-        lmp.atom("v")[:] = v
+        lmp.atom("v")[at] = v
     if force is not None and lmp.nlocal:
         lmp.external_force(force_fix)[:] = force
 
@@ -228,7 +238,12 @@ class Follower:
         self.lmp.variable(name)
 
     def do_atoms(self, temperature) -> None:
+        self.rows = None
         gather_arrays(self.comm, local_atoms(self.lmp, temperature))
+
+    def do_atoms_of(self, ids, temperature) -> None:
+        self.rows, parts = local_atoms_of(self.lmp, ids, temperature)
+        gather_arrays(self.comm, parts)
 
     def do_count(self) -> None:
         self.comm.gather(self.lmp.nlocal, root=ROOT)
@@ -263,4 +278,4 @@ class Follower:
             self.comm.gather(mine, root=ROOT)
 
     def do_write(self, force_fix) -> None:
-        write_local(self.lmp, *self.comm.scatter(None, root=ROOT), force_fix=force_fix)
+        write_local(self.lmp, *self.comm.scatter(None, root=ROOT), force_fix=force_fix, rows=getattr(self, "rows", None))

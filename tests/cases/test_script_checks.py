@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import glass_toml
 
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
@@ -61,16 +62,7 @@ def toml(types="[1]", temperature="temperature = 300.0"):
 script = "in.run"
 [effects]
 contact_heat = "A"
-[materials.glass]
-types = {types}
-{temperature}
-density = 2500.0
-youngs_modulus = 63e9
-poisson_ratio = 0.25
-yield_stress = 500e6
-heat_capacity = 840.0
-conductivity = 1.0
-[output]
+{glass_toml("glass", types, temperature)}[output]
 vtk = false
 pictures = false
 """

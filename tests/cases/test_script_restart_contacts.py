@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import glass_toml
 
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
@@ -53,20 +54,11 @@ set atom 121 diameter 0.002 density 2500
 run 8000
 """
 
-TOML = """[dem]
+TOML = f"""[dem]
 script = "in.run"
 [effects]
 contact_heat = "A"
-[materials.glass]
-types = [1]
-temperature = 300.0
-density = 2500.0
-youngs_modulus = 63e9
-poisson_ratio = 0.25
-yield_stress = 500e6
-heat_capacity = 840.0
-conductivity = 1.0
-[time]
+{glass_toml()}[time]
 sample_every = 5
 [output]
 vtk = false
