@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 
 from plugins.heat import MODELS, PAPER_SET, Pair, collide
+from plugins.heat.comparison import COMPARISON, DemPair
 from plugins.heat.exact import OUTPUT_KEYS
 from plugins.heat.fast import REGIMES, collide_fast
 from plugins.heat.validity import check_scales
@@ -30,8 +31,10 @@ PAIR_OPTIONS = (
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--model", default="A", choices=sorted(MODELS) + ["all"],
-                   help="contact model; 'all' gives each")
+    p.add_argument("--model", default="A", choices=sorted(MODELS) + sorted(COMPARISON) + ["all"],
+                   help="contact model: the paper's A, B, C ('all' gives each), or a comparison model of "
+                        "plugins/heat/comparison (its own closed form or integration, whatever --method; "
+                        "e is null: it gives no restitution)")
     p.add_argument("--v0", type=float, nargs="+", default=[1.0],
                    help="normal impact speed(s) [m/s]; several give a JSON list")
     p.add_argument("--method", default="exact", choices=("exact", "fast", "fit"),
@@ -45,6 +48,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         p.add_argument(f"--{name}", type=float, default=PAPER_SET[name], help=text)
     p.add_argument("--c-log", dest="c_log", type=float, default=None,
                    help="constant of ln in eq. (8) [-]; default 3*b1 (continuous force)")
+    p.add_argument("--dem-Estar", dest="dem_Estar", type=float, default=None,
+                   help="the DEM's softened effective modulus [Pa] (the comparison models that need the DEM's contact)")
+    p.add_argument("--dem-e", dest="dem_e", type=float, default=None,
+                   help="the DEM's coefficient of restitution [-] (with --dem-Estar)")
+    p.add_argument("--dem-Estar-original", dest="dem_Estar_original", type=float, default=None,
+                   help="heat/gran's original modulus [Pa] (softened_corrected); default --Estar")
 
 
 def pair_from_args(args) -> Pair:
@@ -54,12 +63,27 @@ def pair_from_args(args) -> Pair:
     return Pair(c_log=args.c_log, **values)
 
 
+def dem_from_args(args, model: str) -> DemPair | None:
+    """The DEM's contact a comparison model needs (None if it needs none)."""
+    if not COMPARISON[model].needs_dem:
+        return None
+    if args.dem_Estar is None or args.dem_e is None:
+        from pyhost.cli import UserError
+        raise UserError(f"--model {model} needs the DEM's softened contact: give --dem-Estar [Pa] and --dem-e [-]")
+    return DemPair(Ystar=args.dem_Estar, restitution=args.dem_e,
+                   Ystar_original=args.Estar if args.dem_Estar_original is None else args.dem_Estar_original)
+
+
 def evaluate(args) -> list[dict]:
     pair = pair_from_args(args)
     models = sorted(MODELS) if args.model == "all" else [args.model]
     rows = []
     for model in models:
-        if args.method == "fit":
+        if model in COMPARISON:
+            out = COMPARISON[model].heat(np.array(args.v0), pair, dem_from_args(args, model))
+            rows += [{"model": model, "v0": v, "Q": float(out["Q"][j]), "t_coll": float(out["t_coll"][j]),
+                      "e": None} for j, v in enumerate(args.v0)]
+        elif args.method == "fit":
             from plugins.heat.fit import collide_fit
             out = collide_fit(np.array(args.v0), pair, model)
             rows += [{"model": model, "v0": v, **{k: float(out[k][j]) for k in ("e", "t_coll", "Q")}}
@@ -110,6 +134,6 @@ def run(args) -> int:
     cols = ("model", "v0", "regime", "delta_max", "t_coll", "e", "Q", "Q_closed_form")
     print("  ".join(f"{c:>15}" for c in cols) + "  flags")
     for r in rows:
-        cells = [f"{r[c]:>15.6g}" if isinstance(r.get(c), float) else f"{r.get(c, '-'):>15}" for c in cols]
+        cells = [f"{r[c]:>15.6g}" if isinstance(r.get(c), float) else f"{r.get(c) or '-':>15}" for c in cols]
         print("  ".join(cells) + "  " + ",".join(r.get("flags", [])))
     return 0

@@ -57,3 +57,30 @@ def test_a_signal_while_the_command_line_is_read_stops_quietly(signum):
     _, err = p.communicate(timeout=60)
     assert p.returncode == 128 + signum, err
     assert "Traceback" not in err and "interrupted:" in err
+
+
+def test_comparison_model_hertz_is_the_closed_form_of_eqs_31_32():
+    """``collide --model hertz``: Sun & Chen's elastic Hertz heat with the paper's published
+    constants, Q = 0.87093 pi R* delta_max dT t_coll^(1/2) / sigma and t_coll = 2.8683
+    (m*^2 / (R* E*^2 v0))^(1/5) (to their 5 digits); e is null (no restitution)."""
+    out = cli("--model", "hertz", "--v0", "0.001", "0.1", "1", "--json")
+    pair = Pair()
+    for row, v0 in zip(out, (0.001, 0.1, 1.0)):
+        d_max = (15 * pair.mstar * v0**2 / (16 * pair.Estar * pair.Rstar**0.5)) ** 0.4
+        t_coll = 2.8683 * (pair.mstar**2 / (pair.Rstar * pair.Estar**2 * v0)) ** 0.2
+        Q = 0.87093 * 3.141592653589793 * pair.Rstar * d_max * pair.dT * t_coll**0.5 / pair.sigma
+        assert row["model"] == "hertz" and row["v0"] == v0 and row["e"] is None
+        assert row["t_coll"] == pytest.approx(t_coll, rel=2e-5)
+        assert row["Q"] == pytest.approx(Q, rel=2e-5)
+
+
+def test_comparison_models_on_the_dem_contact_need_it():
+    """softened conducts over the DEM's softened contact: without --dem-Estar and --dem-e it is
+    refused (exit 2, naming them); with them it is the plugin's model on that DemPair."""
+    r = subprocess.run([sys.executable, "-m", "pyhost", "collide", "--model", "softened", "--v0", "1"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "--dem-Estar" in r.stderr and "--dem-e" in r.stderr
+    from plugins.heat.comparison import COMPARISON, DemPair
+    out = cli("--model", "softened", "--v0", "1", "--dem-Estar", "5e6", "--dem-e", "0.9", "--json")
+    ref = COMPARISON["softened"].heat(1.0, Pair(), DemPair(Ystar=5e6, restitution=0.9, Ystar_original=Pair().Estar))
+    assert out["Q"] == pytest.approx(float(ref["Q"]), rel=1e-12) and out["e"] is None
