@@ -76,6 +76,30 @@ run 6000
 """
 
 
+SOFT_DEM = "{ youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }"
+"""A softened DEM contact for a material table (dem = ...)."""
+
+
+def steel_toml(dem: str = SOFT_DEM) -> str:
+    """A case.toml [materials.steel] table: the steel of the paper's examples (SI), with the
+    DEM's softened contact ``dem``."""
+    return f"""[materials.steel]
+density = 7800.0
+youngs_modulus = 210e9
+poisson_ratio = 0.3
+yield_stress = 300e6
+heat_capacity = 470.0
+conductivity = 45.0
+dem = {dem}
+"""
+
+
+def steel_material(dem=None):
+    """The same steel as a pyhost.scene.Material (DEM contact: 1e7 Pa, e = 0.9 unless given)."""
+    from pyhost.scene import DemContact, Material
+    return Material(7800.0, 210e9, 0.3, 300e6, 470.0, 45.0, dem or DemContact(youngs_modulus=1e7, restitution=0.9))
+
+
 def glass_toml(name: str = "glass", types: str = "[1]", temperature: str = "temperature = 300.0") -> str:
     """A case.toml [materials.NAME] table of soda-lime glass (SI), for users' scripts whose
     particles are glass beads of density 2500 kg/m^3."""

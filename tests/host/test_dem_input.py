@@ -5,22 +5,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import steel_toml
 
 from pyhost.dem_input import input_lines, place_particles, write_data
 from pyhost.scene import SceneError, load_scene
 
 pytestmark = pytest.mark.engines
 
-STEEL = """
-[materials.steel]
-density = 7800.0
-youngs_modulus = 210e9
-poisson_ratio = 0.3
-yield_stress = 300e6
-heat_capacity = 470.0
-conductivity = 45.0
-dem = {{ youngs_modulus = 2e8, restitution = {e} }}
-"""
+STEEL = "\n" + steel_toml("{{ youngs_modulus = 2e8, restitution = {e} }}")
 HEAD_ON = STEEL + """
 [[particles]]
 material = "steel"

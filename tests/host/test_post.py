@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import steel_toml
 import pyvista
 
 from pyhost.post import load_post_scene
@@ -24,16 +25,7 @@ heat_capacity = 800.0
 conductivity = 1.0
 dem = { youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }
 """
-STEEL_WALL = """
-[materials.steel]
-density = 7800.0
-youngs_modulus = 210e9
-poisson_ratio = 0.3
-yield_stress = 300e6
-heat_capacity = 470.0
-conductivity = 45.0
-dem = { youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }
-
+STEEL_WALL = "\n" + steel_toml() + """
 [[walls]]
 fix = "walls"
 material = "steel"

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import SOFT_DEM, steel_toml
 
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
@@ -46,7 +47,7 @@ dump vtk all custom/vtk 20 post/drop*.vtk id type x y z vx vy vz radius f_Temp[0
 run 6000
 """
 
-SCENE = """[materials.glass]
+SCENE = f"""[materials.glass]
 types = [1]
 density = 2500.0
 youngs_modulus = 63e9
@@ -54,17 +55,9 @@ poisson_ratio = 0.22
 yield_stress = 500e6
 heat_capacity = 800.0
 conductivity = 1.0
-dem = { youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }
+dem = {SOFT_DEM}
 
-[materials.steel]
-density = 7800.0
-youngs_modulus = 210e9
-poisson_ratio = 0.3
-yield_stress = 300e6
-heat_capacity = 470.0
-conductivity = 45.0
-dem = { youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }
-
+{steel_toml()}
 [[walls]]
 fix = "floor"
 material = "steel"

@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import steel_material
 from scipy.integrate import quad, solve_ivp
 from scipy.special import betainc
 
@@ -12,7 +13,7 @@ from plugins.heat.comparison import COMPARISON, DemPair, get_comparison
 from pyhost.contact_heat import dem_pair, evaluate, pair_properties, side_heat
 from pyhost.scene import DemContact, Material
 
-STEEL = Material(7800.0, 210e9, 0.3, 300e6, 470.0, 45.0, DemContact(youngs_modulus=1e7, restitution=0.9))
+STEEL = steel_material()
 ALU = Material(2700.0, 70e9, 0.33, 100e6, 900.0, 200.0, DemContact(youngs_modulus=5e7, restitution=0.6,
                                                                    poisson_ratio=0.25))
 

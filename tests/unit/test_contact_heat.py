@@ -3,13 +3,14 @@ import math
 
 import numpy as np
 import pytest
+from conftest import steel_material
 
 from plugins.heat import Pair, collide
 from pyhost.contact_heat import evaluate, evaluate_flagged, pair_properties, restitution_impulse
 from pyhost.scene import DemContact, Material
 
 DEM = DemContact(youngs_modulus=1e7, restitution=0.9)
-STEEL = Material(7800.0, 210e9, 0.3, 300e6, 470.0, 45.0, DEM)
+STEEL = steel_material(DEM)
 GLASS = Material(2500.0, 63e9, 0.22, 1e9, 840.0, 1.0, DEM, b1=1.1, b2=3.0)
 
 
