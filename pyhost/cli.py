@@ -14,15 +14,11 @@ import importlib
 import re
 import sys
 
-from pyhost.exitcodes import classify
+from pyhost.exitcodes import UserError, classify  # noqa: F401  (UserError: for the commands)
 from pyhost.signals import stopping
 
 COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench", "post", "compare",
             "collisions")
-
-
-class UserError(Exception):
-    """A problem with the user's input: printed as one line, exit status 2."""
 
 
 class Parser(argparse.ArgumentParser):

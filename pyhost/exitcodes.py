@@ -12,13 +12,17 @@ BAD_INPUT = 2           # the scene, an argument, a file or folder given: named 
 FAILED = 3              # the simulation ran and failed: diverged, particle lost, solver died
 
 
+class UserError(Exception):
+    """A problem with the user's input: printed as one line, exit status 2 (also importable
+    from pyhost.cli, where commands take it)."""
+
+
 class SimulationFailed(RuntimeError):
     """A run that started from valid input and failed (exit code 3)."""
 
 
 def classify(exc: BaseException) -> tuple[int, str]:
     """Exit code and message for an exception that ended a command."""
-    from pyhost.cli import UserError
     from pyhost.engines.openfoam import FluidError
 
     if isinstance(exc, Interrupted):
