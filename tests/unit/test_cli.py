@@ -47,16 +47,17 @@ def test_help_documents_units():
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
-def test_a_signal_while_the_command_line_is_read_stops_quietly(signum):
+def test_a_signal_while_the_command_line_is_read_stops_quietly(signum, tmp_path):
     """Ctrl-C in the first half second (while every command is imported) used to print a
-    KeyboardInterrupt traceback: now one line and 128 + n."""
-    p = subprocess.Popen([sys.executable, "-m", "pyhost", "run", "cases/two-particles", "--out", "/nonexistent/x"],
+    KeyboardInterrupt traceback: now one line and 128 + n, and nothing written."""
+    p = subprocess.Popen([sys.executable, "-m", "pyhost", "run", "cases/two-particles", "--out", str(tmp_path / "x")],
                          cwd=Path(__file__).resolve().parents[2], stderr=subprocess.PIPE, text=True)
     time.sleep(0.15)
     p.send_signal(signum)
     _, err = p.communicate(timeout=60)
     assert p.returncode == 128 + signum, err
     assert "Traceback" not in err and "interrupted:" in err
+    assert not (tmp_path / "x").exists()
 
 
 def test_comparison_model_hertz_is_the_closed_form_of_eqs_31_32():
