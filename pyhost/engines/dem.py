@@ -271,14 +271,10 @@ class Dem:
             T = lmp.temperature() if temperature and lmp.nlocal else (np.zeros(0) if temperature else None)
             return Atoms(lmp.atom("id").astype(np.int64), lmp.atom("x"), lmp.atom("v"), lmp.atom("radius"),
                          lmp.atom("rmass"), lmp.atom("type"), T)
-        if self._pending is not None and self._rows is None and (not temperature or self._pending[0].T is not None):
+        if self._all_current(temperature):
             return self._pending[0]     # no run or command since: as serially, the same arrays
         self._order("atoms", temperature)
-        cols, counts = gather_arrays(self.link.comm, local_atoms(lmp, temperature))
-        self._counts, self._rows = np.array(counts), None
-        atoms = Atoms(cols[0].astype(np.int64), *cols[1:6], cols[6] if temperature else None)
-        self._pending = (atoms, None if atoms.T is None else atoms.T.copy(), atoms.v.copy())
-        return atoms
+        return self._gathered(local_atoms(lmp, temperature), None, temperature)
 
     @collective
     def atoms_of(self, ids, temperature: bool = True) -> Atoms:
@@ -286,12 +282,21 @@ class Dem:
         that own them (the ids go to every rank), in no particular order; what the loop
         writes into their T and v goes back as with :meth:`atoms`. Serially, and while the
         atoms gathered last are still current: all atoms, as :meth:`atoms`."""
-        if self.link is None or (self._pending is not None and self._rows is None
-                                 and (not temperature or self._pending[0].T is not None)):
+        if self.link is None or self._all_current(temperature):
             return self.atoms(temperature)
-        self._commit()
         self._order("atoms_of", np.asarray(ids, np.int64), temperature)
         rows, parts = local_atoms_of(self.lmp, ids, temperature)
+        return self._gathered(parts, rows, temperature)
+
+    def _all_current(self, temperature: bool) -> bool:
+        """Under MPI: whether the atoms gathered last are all atoms, with T if asked, and no
+        run or command came since."""
+        return (self._pending is not None and self._rows is None
+                and (not temperature or self._pending[0].T is not None))
+
+    def _gathered(self, parts, rows, temperature: bool) -> Atoms:
+        """All ranks' ``parts`` (rank 0's own: its local ``rows``, None for all) gathered on rank
+        0 as the atoms whose T and v go back at the next call (``_commit``)."""
         cols, counts = gather_arrays(self.link.comm, parts)
         self._counts, self._rows = np.array(counts), rows
         atoms = Atoms(cols[0].astype(np.int64), *cols[1:6], cols[6] if temperature else None)

@@ -250,7 +250,7 @@ class RankEvents:
     """Rank 0's recorder under MPI: every rank's own :class:`ContactEvents` (each records the
     contacts of its atoms, in compiled code), ordered through the link
     (``pyhost.engines.ranks.Link``); what rank 0 asks of them is joined here, events and flux
-    histories only. The interface is ContactEvents'."""
+    histories only. The interface is ContactEvents' (but meshes_by_history, a test's probe)."""
 
     def __init__(self, lmp, link, fix: str = FIX):
         self.link, self.joined = link, []
