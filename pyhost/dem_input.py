@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from plugins.heat.compression import K_HERTZ
+from plugins.dem.hertz import effective_modulus, hertz_collision_time
 from pyhost.scene import Scene, SceneError
 
 PLANES = {"xlo": ("xplane", 0), "xhi": ("xplane", 1), "ylo": ("yplane", 2), "yhi": ("yplane", 3),
@@ -150,19 +150,13 @@ def input_lines(scene: Scene, data_file: Path, skin: float | None = None) -> lis
     return lines
 
 
-def hertz_collision_time(Estar, Rstar, mstar, v):
-    """Duration [s] of an elastic Hertz impact at speed v [m/s] with effective modulus Estar
-    [Pa], radius Rstar [m] and mass mstar [kg] (eq. 32)."""
-    return 2.0 * K_HERTZ * (15.0 / 16.0) ** 0.4 * (mstar**2 / (Estar**2 * Rstar * v)) ** 0.2
-
-
 def dem_collision_time(scene: Scene, v: float) -> float:
     """Shortest Hertz collision time of the DEM among the scene's particles at impact speed
     v [m/s] (eq. 32 with the DEM's softened modulus) [s]: the DEM step must resolve it."""
     times = []
     for grp in scene.particles:
         m = scene.materials[grp.material]
-        E = m.dem.youngs_modulus / (2.0 * (1.0 - m.dem.poisson_ratio**2))
+        E = effective_modulus(m.dem.youngs_modulus, m.dem.poisson_ratio, m.dem.youngs_modulus, m.dem.poisson_ratio)
         mass = 4.0 / 3.0 * math.pi * grp.radius**3 * m.density
         times.append(hertz_collision_time(E, grp.radius / 2.0, mass / 2.0, v))
     return min(times)

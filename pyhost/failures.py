@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyhost.collisions import DemHertz
+from plugins.dem.hertz import DemHertz
+from plugins.heat.batch import dem_pair
 from pyhost.dem_input import dem_collision_time
 from pyhost.exitcodes import SimulationFailed
 
@@ -63,9 +64,7 @@ def likely_cause(scene, group: int, x, v, t: float) -> str:
                 f"({t_c / dt:.1f} steps per collision, need >= {STEPS_PER_COLLISION}): "
                 f"use dem_step <= {t_c / 20:.2g} s")
     g = scene.particles[group]
-    m, w = scene.materials[g.material].dem, scene.materials[walls[face].material].dem
-    law = DemHertz(1.0 / ((1 - m.poisson_ratio**2) / m.youngs_modulus + (1 - w.poisson_ratio**2) / w.youngs_modulus),
-                   1.0)
+    law = DemHertz(dem_pair(scene.materials[g.material], scene.materials[walls[face].material]).Ystar, 1.0)
     mass = 4.0 / 3.0 * np.pi * g.radius**3 * scene.materials[g.material].density
     overlap = float(law.max_overlap(speed, g.radius, mass))
     if overlap > g.radius:

@@ -30,9 +30,11 @@ from pathlib import Path
 import numpy as np
 
 from plugins import convection
-from pyhost.collisions import (WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat,
-                               temperature_difference)
-from pyhost.contact_heat import evaluate_flagged, restitution_impulse, side_heat
+from plugins.dem.hertz import DemHertz, effective_modulus
+from plugins.dem.impulse import restitution_impulse
+from plugins.heat.batch import evaluate_flagged, side_heat
+from plugins.heat.exchange import exchange_heat, temperature_difference
+from pyhost.collisions import WALL_BASE, ContactTracker, contact_keys
 from pyhost.dem_input import script_dem_contacts
 from pyhost import checkpoint, signals
 from pyhost.engines.dem import Dem
@@ -419,7 +421,7 @@ class Coupling:
             E = self.dem.type_values("youngsModulus", (a, b))
             nu = self.dem.type_values("poissonsRatio", (a, b))
             e = self.dem.type_pair_value("coefficientRestitution", a, b)
-            self.laws[a, b] = DemHertz(1.0 / ((1 - nu[0] ** 2) / E[0] + (1 - nu[1] ** 2) / E[1]), e)
+            self.laws[a, b] = DemHertz(effective_modulus(E[0], nu[0], E[1], nu[1]), e)
         return self.laws[a, b]
 
     def flag_outside_range(self, flagged, v0) -> None:

@@ -8,7 +8,7 @@
    appearance is its collision; a particle touching several triangles of one mesh at once is
    one collision. Its normal impact speed is the approach speed at first appearance, carried
    back to touch with the DEM's own contact law (``DemHertz.impact_speed``) over the overlap.
-3. Each model gives every collision's heat per kelvin, e and t_coll (``contact_heat.evaluate``);
+3. Each model gives every collision's heat per kelvin, e and t_coll (``plugins.heat.batch.evaluate``);
    the heat is moved collision by collision, in time order, with the temperatures of that
    moment (``collisions.exchange_heat``), while the particle dumps are replayed into a VTK
    series of temperatures and heat received.
@@ -27,10 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.collisions import WALL_BASE, DemHertz, contact_keys, exchange_heat
-from pyhost.contact_heat import evaluate_flagged
+from plugins.dem.hertz import DemHertz, hertz_collision_time
+from plugins.heat.batch import dem_pair, evaluate_flagged
+from plugins.heat.exchange import exchange_heat
+from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.contacts import find_contacts
-from pyhost.dem_input import hertz_collision_time
 from pyhost.dumps import STREAM_ERRORS, DumpError, DumpReader, expand, open_text
 from pyhost.outdir import write_atomic
 from pyhost.output import VtkSeries
@@ -399,14 +400,13 @@ class Post:
         mats = list(self.scene.materials.values())
         laws = {}
         for a, b in set(zip(mi.tolist(), mj.tolist())):
-            A, B = mats[a].dem, mats[b].dem
-            for k, d in ((a, A), (b, B)):
-                if d is None:
+            for k in (a, b):
+                if mats[k].dem is None:
                     raise ValueError(f"{self.scene.path}: materials.{list(self.scene.materials)[k]}.dem: post "
                                      f"recovers impact speeds with the DEM's contact law and reads no script "
                                      f"values: give the table (youngs_modulus, restitution, poisson_ratio)")
-            Y = 1.0 / ((1 - A.poisson_ratio**2) / A.youngs_modulus + (1 - B.poisson_ratio**2) / B.youngs_modulus)
-            laws[a, b] = (Y, DemHertz(Y, 0.5 * (A.restitution + B.restitution)))
+            dem = dem_pair(mats[a], mats[b])
+            laws[a, b] = (dem.Ystar, DemHertz(dem.Ystar, dem.restitution))
         return laws
 
     def impact_speeds(self, c) -> np.ndarray:

@@ -1,5 +1,5 @@
 """What side models cost: time per collision of each heat model through the host's call
-(``pyhost.contact_heat.evaluate``, fast path), on the hot-cold bed's material.
+(``plugins.heat.batch.evaluate``, fast path), on the hot-cold bed's material.
 
 Collisions: N particle pairs of the bed's 1 mm aluminium beads (cases/hot-cold-bed), impact
 speeds log-uniform in 0.01-1 m/s, one material pair; best of ``--repeats`` runs, one core.
@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from plugins.heat import MODEL_NAMES
-from pyhost.contact_heat import evaluate, side_heat
+from plugins.heat.batch import evaluate, side_heat
 from pyhost.scene import load_scene
 
 

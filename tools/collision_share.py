@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pyhost.dem_input import dem_collision_time  # noqa: E402
-from pyhost.fluidization import wen_yu_umf  # noqa: E402
+from plugins.bed import wen_yu_umf  # noqa: E402
 from pyhost.scene import load_scene  # noqa: E402
 
 CASE = ROOT / "cases" / "hot-cold-gas-bed" / "case.toml"

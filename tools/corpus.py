@@ -42,7 +42,7 @@ from foamlib import FoamFile  # noqa: E402
 
 from plugins.drag import get as drag_law  # noqa: E402
 from pyhost.engines.openfoam import run_utility  # noqa: E402
-from pyhost.fluidization import ergun_pressure_drop  # noqa: E402
+from plugins.bed import ergun_pressure_drop  # noqa: E402
 
 LIGGGHTS_DOC = Path("/usr/share/doc/liggghts/examples/LIGGGHTS/Tutorials_public")
 G = 9.81

@@ -10,10 +10,8 @@ lists case by case.
 from __future__ import annotations
 
 import contextlib
-import copy
 import io
 import json
-import math
 import subprocess
 import sys
 import tempfile

@@ -4,6 +4,9 @@ Source: CFDEMproject/LIGGGHTS-PUBLIC, src/normal_model_hertz.h,
 ``NormalModel<HERTZ>::surfacesIntersect``: kn = (4/3) Y* (R* delta)^(1/2),
 gamma_n = -2 (5/6)^(1/2) beta (2 Y* (R* delta)^(1/2) m*)^(1/2), F = kn delta - gamma_n v_n,
 and beta from the restitution (``MODEL_PARAMS::createBetaEff``). SI units; pure functions.
+
+Also the contact quantities every layer shares: the effective modulus of two bodies (the
+heat plugin's eq. 4 and the DEM's Y*) and the duration of an elastic Hertz impact (eq. 32).
 """
 from __future__ import annotations
 
@@ -12,6 +15,29 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.special import beta as beta_fn
+
+K_HERTZ = 0.4 * beta_fn(0.4, 0.5)
+"""int_0^1 (1 - y^(5/2))^(-1/2) dy = 1.4716...: the Hertz half-collision time in units of
+delta_max / v0 (the 1.472 of eqs. 23 and 29)."""
+
+
+def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
+    """E* = [(1 - nu1^2)/E1 + (1 - nu2^2)/E2]^-1 [Pa] (Kosinski et al. 2014, sec. 3.1.1,
+    after eq. 4; LIGGGHTS' Yeff). Young's moduli E [Pa], Poisson ratios nu [-]."""
+    for name, value in (("E1", E1), ("E2", E2)):
+        if not (np.all(np.asarray(value) > 0) and np.all(np.isfinite(value))):
+            raise ValueError(f"{name} must be a positive finite Young's modulus [Pa], got {value!r}")
+    for name, value in (("nu1", nu1), ("nu2", nu2)):
+        if not np.all((np.asarray(value) > -1) & (np.asarray(value) < 0.5)):
+            raise ValueError(f"{name} must be a Poisson ratio in (-1, 0.5), got {value!r}")
+    return 1.0 / ((1 - np.square(nu1)) / E1 + (1 - np.square(nu2)) / E2)
+
+
+def hertz_collision_time(Estar, Rstar, mstar, v):
+    """Duration [s] of an elastic Hertz impact at speed v [m/s] with effective modulus Estar
+    [Pa], radius Rstar [m] and mass mstar [kg] (eq. 32)."""
+    return 2.0 * K_HERTZ * (15.0 / 16.0) ** 0.4 * (mstar**2 / (Estar**2 * Rstar * v)) ** 0.2
 
 
 def restitution_beta(e: float) -> float:

@@ -10,7 +10,8 @@ Public API (SI units throughout):
 """
 from plugins.heat.exact import Collision, collide
 from plugins.heat.models import MODELS, get_model
-from plugins.heat.pair import PAPER_SET, Pair, effective_modulus
+from plugins.dem.hertz import effective_modulus
+from plugins.heat.pair import PAPER_SET, Pair
 from plugins.heat.comparison import COMPARISON
 
 MODEL_NAMES = tuple(sorted(MODELS)) + tuple(sorted(COMPARISON))

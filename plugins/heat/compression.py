@@ -20,12 +20,9 @@ from functools import lru_cache
 import numpy as np
 from numpy.polynomial import Chebyshev
 from scipy.optimize import brentq
-from scipy.special import beta as beta_fn
 from scipy.special import betainc, betaincc
 
-K_HERTZ = 0.4 * beta_fn(0.4, 0.5)
-"""int_0^1 (1 - y^(5/2))^(-1/2) dy = 1.4716...: the Hertz half-collision time in units of
-delta_max / v0 (the 1.472 of eqs. 23 and 29)."""
+from plugins.dem.hertz import K_HERTZ  # noqa: F401  (re-exported: the 1.472 of eqs. 23 and 29)
 
 
 def hertz_time_from_top(w, x_top, t_half, y=None):

@@ -125,11 +125,12 @@ class Table:
 
 
 @lru_cache(maxsize=1)
-def source_digest(root: Path = Path(__file__).parent) -> str:
-    """SHA-256 of every Python file of the heat plugin (the models in models/ included), with
-    their paths: the tables depend on all of them, so an edited file gives a new cache key."""
+def source_digest(root: Path = Path(__file__).parents[1]) -> str:
+    """SHA-256 of every Python file of the heat plugin (the models in models/ included) and of
+    the DEM plugin it takes the Hertz constants from, with their paths: the tables depend on
+    all of them, so an edited file gives a new cache key."""
     h = hashlib.sha256()
-    for f in sorted(root.rglob("*.py")):
+    for f in sorted(f for part in ("heat", "dem") for f in (root / part).rglob("*.py")):
         h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
     return h.hexdigest()
 

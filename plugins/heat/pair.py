@@ -27,17 +27,6 @@ PAPER_SET = dict(R1=2e-3, R2=2e-3, rho1=6000.0, rho2=6000.0, Estar=100e9, Y=300e
 """The parameter set of Kosinski et al. (2014), sec. 6."""
 
 
-def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
-    """E* = [(1 - nu1^2)/E1 + (1 - nu2^2)/E2]^-1 [Pa] (sec. 3.1.1, after eq. 4)."""
-    for name, value in (("E1", E1), ("E2", E2)):
-        if not (np.all(np.asarray(value) > 0) and np.all(np.isfinite(value))):
-            raise ValueError(f"{name} must be a positive finite Young's modulus [Pa], got {value!r}")
-    for name, value in (("nu1", nu1), ("nu2", nu2)):
-        if not np.all((np.asarray(value) > -1) & (np.asarray(value) < 0.5)):
-            raise ValueError(f"{name} must be a Poisson ratio in (-1, 0.5), got {value!r}")
-    return 1.0 / ((1 - np.square(nu1)) / E1 + (1 - np.square(nu2)) / E2)
-
-
 @dataclass(frozen=True)
 class Pair:
     """Two colliding bodies (or a sphere and a wall). SI units; fields may be numpy arrays.

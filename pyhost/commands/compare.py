@@ -48,7 +48,7 @@ def material(name: str, dem_modulus: float):
 
 def heat(model: str, mat, R: float, v0) -> np.ndarray:
     """Q [J] at dT = 1 K of head-on collisions of two equal spheres of radius R [m]."""
-    from pyhost.contact_heat import evaluate
+    from plugins.heat.batch import evaluate
     v0 = np.atleast_1d(np.asarray(v0, float))
     n = len(v0)
     zeros, radius = np.zeros(n, int), np.full(n, R)
@@ -109,14 +109,42 @@ def run(args) -> int:
 def bed_totals(run_dir: Path, models) -> dict:
     """Heat between particles of each model on a run's collisions (its case.toml is the
     folder above its output folder)."""
-    from pyhost.contact_heat import heat_by_model_offline
-    from pyhost.scene import load_scene
-
     from pyhost.output import read_collisions
+    from pyhost.scene import load_scene
 
     cols = read_collisions(run_dir)
     totals = heat_by_model_offline(load_scene(run_dir.parent / "case.toml"), cols, models)
     return dict(totals, _collisions=len(cols["i"]))
+
+
+def heat_by_model_offline(scene, collisions, models) -> dict:
+    """{model: heat between particles [J], sum of |Q|} of each model on the collisions of a
+    finished run (``collisions``: the columns of its collisions.csv as arrays: i, j, wall
+    (1-based, 0 for none), v0, Q, model). Each collision's dT is the one the run used,
+    Q / (Q per kelvin of the run's own model), so a model's column is what a side column
+    would have held (collisions with an adiabatic wall or capped ones carry no dT back).
+    Box scenes only: particle ids are the order of ``place_particles``."""
+    from plugins.heat.batch import evaluate
+    from pyhost.dem_input import material_index, place_particles
+
+    p = place_particles(scene)
+    materials = list(scene.materials.values())
+    wall_mat = np.array([material_index(scene)[w.material] for w in scene.walls] or [0], int)
+    i = np.asarray(collisions["i"], int) - 1
+    w = np.asarray(collisions["wall"], int)
+    wall = w > 0
+    j = np.where(wall, 0, np.asarray(collisions["j"], int) - 1)
+    mi, R_i = p.material[i], p.radius[i]
+    mj = np.where(wall, wall_mat[np.maximum(w - 1, 0)], p.material[j])
+    R_j = np.where(wall, np.inf, p.radius[j])
+    v0, ones = np.asarray(collisions["v0"], float), np.ones(len(i))
+    main = set(np.asarray(collisions["model"]).tolist())
+    if len(main) != 1:
+        raise ValueError(f"collisions.csv holds {len(main)} heat models ({sorted(main)}); expected one")
+    G_main = evaluate(main.pop(), "fast", materials, mi, mj, R_i, R_j, v0, ones)[0]
+    dT = np.asarray(collisions["Q"], float) / G_main
+    return {m: float(np.abs(evaluate(m, "fast", materials, mi, mj, R_i, R_j, v0, ones)[0] * dT)[~wall].sum())
+            for m in models}
 
 
 def has_collisions(run_dir: Path) -> bool:

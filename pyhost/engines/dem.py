@@ -18,7 +18,6 @@ the arrays are LIGGGHTS' own memory and nothing needs to go back.
 """
 from __future__ import annotations
 
-import ctypes
 import os
 from dataclasses import dataclass
 from pathlib import Path

@@ -1,8 +1,5 @@
 """LIGGGHTS bridge on the real engine: two 2 mm glass-like spheres meeting head-on."""
 import math
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest

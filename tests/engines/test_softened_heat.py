@@ -6,12 +6,11 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from plugins.heat import Pair
 from plugins.heat.comparison import COMPARISON, DemPair
-from plugins.heat.pair import effective_modulus
+from plugins.dem.hertz import effective_modulus
 from pyhost.engines.liggghts import Liggghts, granular_box
 
 pytestmark = pytest.mark.engines

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from plugins.heat import Pair, collide
-from pyhost.contact_heat import pair_properties
+from plugins.heat.batch import pair_properties
 from pyhost.scene import load_scene
 
 pytestmark = pytest.mark.engines

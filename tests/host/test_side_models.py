@@ -10,7 +10,7 @@ import pytest
 
 from plugins.heat import Pair
 from plugins.heat.comparison import COMPARISON
-from pyhost.contact_heat import dem_pair, pair_properties
+from plugins.heat.batch import dem_pair, pair_properties
 from pyhost.scene import load_scene
 
 pytestmark = pytest.mark.engines

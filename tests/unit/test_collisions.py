@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pyhost.collisions import WALL_BASE, ContactTracker, DemHertz, contact_keys, exchange_heat
+from plugins.heat.exchange import exchange_heat
+from plugins.dem.hertz import DemHertz
+from pyhost.collisions import WALL_BASE, ContactTracker, contact_keys
 
 LAW = DemHertz(Ystar=5e7, e=0.8)          # a softened DEM contact
 R, M = 1e-3, 2e-5                          # effective radius [m] and mass [kg]

@@ -9,7 +9,7 @@ import pytest
 
 from plugins.heat import MODEL_NAMES
 from pyhost.cli import main
-from pyhost.contact_heat import evaluate
+from plugins.heat.batch import evaluate
 from pyhost.scene import load_scene
 
 BED = Path(__file__).resolve().parents[2] / "cases" / "hot-cold-bed" / "case.toml"

@@ -10,7 +10,7 @@ from scipy.special import betainc
 
 from plugins.heat import MODEL_NAMES, Pair, collide
 from plugins.heat.comparison import COMPARISON, DemPair, get_comparison
-from pyhost.contact_heat import dem_pair, evaluate, pair_properties, side_heat
+from plugins.heat.batch import dem_pair, evaluate, pair_properties, side_heat
 from pyhost.scene import DemContact, Material
 
 STEEL = steel_material()

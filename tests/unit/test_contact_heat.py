@@ -6,7 +6,8 @@ import pytest
 from conftest import steel_material
 
 from plugins.heat import Pair, collide
-from pyhost.contact_heat import evaluate, evaluate_flagged, pair_properties, restitution_impulse
+from plugins.dem.impulse import restitution_impulse
+from plugins.heat.batch import evaluate, evaluate_flagged, pair_properties
 from pyhost.scene import DemContact, Material
 
 DEM = DemContact(youngs_modulus=1e7, restitution=0.9)

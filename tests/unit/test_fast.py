@@ -56,17 +56,19 @@ def test_fast_rejects_unknown_outputs(paper_pair):
         collide_fast([1.0], paper_pair, "A", outputs=("e", "heat"))
 
 
-def test_table_cache_key_changes_when_any_plugin_file_changes(tmp_path):
-    """The tables depend on every file of the heat plugin: an edit of a model in models/ (not
-    only of the integrators) gives another source digest, hence another cache key, so a stale
+@pytest.mark.parametrize("edited", ["heat/models/A.py", "dem/hertz.py"])
+def test_table_cache_key_changes_when_any_plugin_file_changes(tmp_path, edited):
+    """The tables depend on every file of the heat plugin and on the DEM plugin's Hertz
+    constants: an edit of a model in models/ (not only of the integrators) or of
+    plugins/dem/hertz.py gives another source digest, hence another cache key, so a stale
     table is never read."""
     import shutil
     from pathlib import Path
     from plugins.heat import fast
-    root = tmp_path / "heat"
-    shutil.copytree(Path(fast.__file__).parent, root, ignore=shutil.ignore_patterns("__pycache__"))
+    root = tmp_path / "plugins"
+    for part in ("heat", "dem"):
+        shutil.copytree(Path(fast.__file__).parents[1] / part, root / part, ignore=shutil.ignore_patterns("__pycache__"))
     before = fast.source_digest.__wrapped__(root)
     assert fast.source_digest.__wrapped__(root) == before
-    model = root / "models" / "A.py"
-    model.write_text(model.read_text() + "\n# edited\n")
+    (root / edited).write_text((root / edited).read_text() + "\n# edited\n")
     assert fast.source_digest.__wrapped__(root) != before

@@ -5,7 +5,8 @@ import json
 import numpy as np
 import pytest
 
-from pyhost.fluidization import ergun_pressure_drop, ergun_umf, measure, wen_yu_umf
+from plugins.bed import ergun_pressure_drop, ergun_umf, wen_yu_umf
+from pyhost.fluidization import measure
 
 AIR = dict(rho=1.2, mu=1.8e-5)
 

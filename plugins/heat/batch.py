@@ -1,12 +1,16 @@
-"""Per-collision heat and restitution from the plugin, for the collisions a sample found.
+"""Heat of many collisions at once between bodies of named materials: the host's and post's
+way into the plugin (``collide`` and ``collide_fast`` take one pair of materials at a time).
 
-The plugin gets the *real* material properties of the scene (never the DEM's softened
-modulus). A pair of materials is one ``plugins.heat.Pair`` with the effective modulus of
-the two (eq. 4) and the yield stress, b1 and b2 of the softer one (lower yield stress):
-plastic deformation starts in the body that yields first.
+A material is any object with the fields of ``pyhost.scene.Material`` (SI): density,
+heat_capacity, conductivity, youngs_modulus, poisson_ratio (the real material), yield_stress,
+b1, b2, and ``dem`` (youngs_modulus, poisson_ratio, restitution of the DEM's softened contact).
 
-Comparison models (``plugins.heat.comparison``) are evaluated by the same call. Those that
-need the DEM's softened contact get it from the materials' ``dem`` tables (``dem_pair``).
+The plugin gets the *real* material properties (never the DEM's softened modulus). A pair of
+materials is one ``Pair`` with the effective modulus of the two (eq. 4) and the yield stress,
+b1 and b2 of the softer one (lower yield stress): plastic deformation starts in the body that
+yields first. Comparison models (``plugins.heat.comparison``) are evaluated by the same call;
+those that need the DEM's softened contact get it from the materials' ``dem`` tables
+(``dem_pair``).
 """
 from __future__ import annotations
 
@@ -82,47 +86,3 @@ def side_heat(models, path: str, materials: list, mat_i, mat_j, R_i, R_j, v0, dT
     """{model: Q [J]} of each side model on the same collisions (``evaluate`` with each);
     side models only report, they move no heat and give no restitution."""
     return {m: evaluate(m, path, materials, mat_i, mat_j, R_i, R_j, v0, dT)[0] for m in models}
-
-
-def restitution_impulse(v_i, v_j, m_i, m_j, normal, e_target, v0):
-    """Velocity changes [m/s] that make the normal separation speed e_target * v0, conserving
-    momentum. normal points from j to i; v_j, m_j of a wall are 0 and inf. e above 1 is
-    clipped to 1 (returned count), so no collision gains energy."""
-    e_target = np.asarray(e_target, float)
-    clipped = int(np.sum(e_target > 1.0))
-    e_target = np.minimum(e_target, 1.0)
-    separation = np.einsum("ij,ij->i", v_i - v_j, normal)
-    change = e_target * v0 - separation
-    wall = np.isinf(m_j)
-    share_i = np.where(wall, 1.0, m_j / np.where(wall, 1.0, m_i + m_j))
-    share_j = np.where(wall, 0.0, m_i / np.where(wall, 1.0, m_i + m_j))
-    return (share_i * change)[:, None] * normal, -(share_j * change)[:, None] * normal, clipped
-
-
-def heat_by_model_offline(scene, collisions, models) -> dict:
-    """{model: heat between particles [J], sum of |Q|} of each model on the collisions of a
-    finished run (``collisions``: the columns of its collisions.csv as arrays: i, j, wall
-    (1-based, 0 for none), v0, Q, model). Each collision's dT is the one the run used,
-    Q / (Q per kelvin of the run's own model), so a model's column is what a side column
-    would have held (collisions with an adiabatic wall or capped ones carry no dT back).
-    Box scenes only: particle ids are the order of ``place_particles``."""
-    from pyhost.dem_input import material_index, place_particles
-
-    p = place_particles(scene)
-    materials = list(scene.materials.values())
-    wall_mat = np.array([material_index(scene)[w.material] for w in scene.walls] or [0], int)
-    i = np.asarray(collisions["i"], int) - 1
-    w = np.asarray(collisions["wall"], int)
-    wall = w > 0
-    j = np.where(wall, 0, np.asarray(collisions["j"], int) - 1)
-    mi, R_i = p.material[i], p.radius[i]
-    mj = np.where(wall, wall_mat[np.maximum(w - 1, 0)], p.material[j])
-    R_j = np.where(wall, np.inf, p.radius[j])
-    v0, ones = np.asarray(collisions["v0"], float), np.ones(len(i))
-    main = set(np.asarray(collisions["model"]).tolist())
-    if len(main) != 1:
-        raise ValueError(f"collisions.csv holds {len(main)} heat models ({sorted(main)}); expected one")
-    G_main = evaluate(main.pop(), "fast", materials, mi, mj, R_i, R_j, v0, ones)[0]
-    dT = np.asarray(collisions["Q"], float) / G_main
-    return {m: float(np.abs(evaluate(m, "fast", materials, mi, mj, R_i, R_j, v0, ones)[0] * dT)[~wall].sum())
-            for m in models}
