@@ -1,8 +1,8 @@
 """Contacts from particle positions: the overlaps the DEM's contact law acts on.
 
 delta = r_i + r_j - |x_i - x_j| for particle pairs (found with scipy's cKDTree, periodic
-where the domain is) and delta = r_i - distance to the plane for the box walls the scene
-declares. The normal points from partner j to particle i; the approach speed
+where the domain is) and delta = r_i - distance to the wall for the box faces and primitive
+walls given (``pyhost.walls``). The normal points from partner j to particle i; the approach speed
 -(v_i - v_j) . n is > 0 while they close in. This is the same overlap LIGGGHTS uses, so the
 host needs positions and velocities only, from whichever bridge runs the DEM.
 """
@@ -14,8 +14,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pyhost.collisions import WALL_BASE
-
-AXIS = {"x": 0, "y": 1, "z": 2}
+from pyhost.walls import face_overlap, primitive_overlap
 
 
 @dataclass(frozen=True)
@@ -35,7 +34,8 @@ class Contacts:
 
 class ContactFinder:
     """Contacts among particles of radii r [m] in box = (xmin, xmax, ..., zmax), periodic where
-    asked, with the box walls named in ``walls`` ("zlo", ...).
+    asked, with the ``walls``: box faces ("zlo", ...) or primitive walls (kind, numbers), as
+    ``pyhost.walls`` places them.
 
     A Verlet list: candidate pairs within 2 r_max + skin come from scipy's cKDTree and are
     reused until some particle has moved more than skin/2 since they were found, which
@@ -43,7 +43,7 @@ class ContactFinder:
     """
 
     def __init__(self, r, box, periodic=(False, False, False), walls=(), skin=None):
-        self.r = np.asarray(r, float)
+        self.r, self.box = np.asarray(r, float), tuple(float(b) for b in box)
         self.lo, self.hi = np.array(box[0::2], float), np.array(box[1::2], float)
         self.size = self.hi - self.lo
         self.per = np.asarray(periodic, bool)
@@ -80,13 +80,10 @@ class ContactFinder:
         n = d / dist[:, None]
         approach = -np.einsum("ij,ij->i", v[i] - v[j], n)
         rows = [(i, j, delta, n, approach)]
-        for w, plane in enumerate(self.walls):
-            axis, side = AXIS[plane[0]], plane[1:]
-            gap = x[:, axis] - self.lo[axis] if side == "lo" else self.hi[axis] - x[:, axis]
-            k = np.flatnonzero(r - gap > 0)
-            nw = np.zeros((len(k), 3))
-            nw[:, axis] = 1.0 if side == "lo" else -1.0
-            rows.append((k, np.full(len(k), WALL_BASE + w), (r - gap)[k], nw, -np.einsum("ij,ij->i", v[k], nw)))
+        for w, wall in enumerate(self.walls):
+            delta, nw = face_overlap(x, r, wall, self.box) if isinstance(wall, str) else primitive_overlap(x, r, wall)
+            k = np.flatnonzero(delta > 0)
+            rows.append((k, np.full(len(k), WALL_BASE + w), delta[k], nw[k], -np.einsum("ij,ij->i", v[k], nw[k])))
         return Contacts(*(np.concatenate([row[c] for row in rows]) for c in range(5)))
 
 

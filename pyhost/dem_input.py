@@ -17,9 +17,8 @@ import numpy as np
 
 from plugins.dem.hertz import effective_modulus, hertz_collision_time
 from pyhost.scene import Scene, SceneError
+from pyhost.walls import face_primitive
 
-PLANES = {"xlo": ("xplane", 0), "xhi": ("xplane", 1), "ylo": ("yplane", 2), "yhi": ("yplane", 3),
-          "zlo": ("zplane", 4), "zhi": ("zplane", 5)}
 
 
 @dataclass(frozen=True)
@@ -137,11 +136,10 @@ def input_lines(scene: Scene, data_file: Path, skin: float | None = None) -> lis
     if g_mag > 0:
         lines.append(f"fix gravity all gravity {num(g_mag)} vector " + " ".join(num(c / g_mag) for c in g))
     index = material_index(scene)
-    box = scene.domain.box
     for k, w in enumerate(scene.walls):
-        kind, side = PLANES[w.plane]
+        kind, (position,) = face_primitive(w.plane, scene.domain.box)
         lines.append(f"fix wall{k} all wall/gran model hertz tangential history primitive "
-                     f"type {index[w.material] + 1} {kind} {num(box[side])}")
+                     f"type {index[w.material] + 1} {kind} {num(position)}")
     if scene.effects.enduring_conduction:       # LIGGGHTS' own conduction through lasting contacts
         lines += ["fix m5 all property/global thermalConductivity peratomtype " + " ".join(num(m.conductivity) for m in mats),
                   "fix m6 all property/global thermalCapacity peratomtype " + " ".join(num(m.heat_capacity) for m in mats),

@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from pyhost.walls import PRIMITIVES
+
 
 class DumpError(ValueError):
     """A problem in a dump file: file, timestep of the frame (None before the first), line, problem."""
@@ -125,7 +127,7 @@ class Script:
     warnings: tuple = ()
     box: np.ndarray | None = None   # (3, 2) lo hi [m] of its create_box, None if unknown
     heat_gran: tuple = ()           # ids of its fix heat/gran
-    planes: dict = field(default_factory=dict)     # primitive plane wall fix id -> (axis 0-2, position m)
+    primitives: dict = field(default_factory=dict)  # primitive wall fix id -> (kind, numbers) (pyhost.walls)
 
 
 SETUP_COMMANDS = ("units", "dimension", "boundary", "atom_style", "atom_modify", "newton", "communicate",
@@ -174,7 +176,7 @@ def read_script(path) -> Script:
     except OSError as exc:
         raise ValueError(f"{path}: cannot read the LIGGGHTS script: {exc.strerror}") from None
     timestep, computes, walls, warnings = None, {}, [], []
-    setup, heat_gran, planes, literal = [], [], {}, True
+    setup, heat_gran, primitives, literal = [], [], {}, True
     text = re.sub(r"&[ \t]*\n", " ", text)
     for number, line in enumerate(text.splitlines(), start=1):
         words = line.split("#")[0].split()
@@ -191,12 +193,13 @@ def read_script(path) -> Script:
         elif words[0] == "fix" and len(words) > 3 and words[3] == "heat/gran":
             heat_gran.append(words[1])
         elif words[0] == "fix" and len(words) > 5 and words[3] == "wall/gran" and "primitive" in words:
-            kind = next((w for w in words if w in ("xplane", "yplane", "zplane")), None)
-            at = words.index(kind) + 1 if kind else len(words)
+            kind = next((w for w in words if w in PRIMITIVES), None)
+            numbers = words[words.index(kind) + 1:][:PRIMITIVES[kind]] if kind else []
             try:
-                planes[words[1]] = ("xyz".index(kind[0]), float(words[at]))
-            except (TypeError, ValueError, IndexError):
-                pass                    # a cylinder or a $variable: post places planes only
+                if kind and len(numbers) == PRIMITIVES[kind]:
+                    primitives[words[1]] = (kind, tuple(float(w) for w in numbers))
+            except ValueError:
+                pass                    # a $variable: post cannot place that wall
         elif words[0] == "compute" and len(words) > 3 and words[3] in LOCAL_STYLES:
             c = parse_compute(line, where)
             computes[c.id] = c
@@ -212,7 +215,7 @@ def read_script(path) -> Script:
                             "give --dt")
         elif not literal:
             timestep = dt
-    return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), planes)
+    return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), primitives)
 
 
 @dataclass(frozen=True, eq=False)

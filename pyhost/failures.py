@@ -18,8 +18,8 @@ from plugins.dem.hertz import DemHertz
 from plugins.heat.batch import dem_pair
 from pyhost.dem_input import dem_collision_time
 from pyhost.exitcodes import SimulationFailed
+from pyhost.walls import FACES
 
-FACES = ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")
 STEPS_PER_COLLISION = 10        # fewer DEM steps than this per collision: under-resolved
 
 

@@ -3,14 +3,14 @@
 1. The particle dumps are read once (``pyhost.dumps``): each particle's type and radius by id,
    its initial temperature (the scene's, else the dump's ``f_Temp`` at its first appearance),
    and, without contact dumps, the contacts of every frame from positions (periodic images
-   from the box, the scene's plane walls).
+   from the box, the scene's box faces and the script's primitive walls, ``pyhost.walls``).
 2. With contact dumps (``compute pair/gran/local`` / ``wall/gran/local``), a pair's first
    appearance is its collision; a particle touching several triangles of one mesh at once is
    one collision. Its normal impact speed is the approach speed at first appearance, carried
    back to touch with the DEM's own contact law (``DemHertz.impact_speed``) over the overlap.
 3. Each model gives every collision's heat per kelvin, e and t_coll (``plugins.heat.batch.evaluate``);
    the heat is moved collision by collision, in time order, with the temperatures of that
-   moment (``collisions.exchange_heat``), while the particle dumps are replayed into a VTK
+   moment (``plugins.heat.exchange.exchange_heat``), while the particle dumps are replayed into a VTK
    series of temperatures and heat received.
 
 Output (``out``): collisions.csv.gz, summary.json, vtk/particles.pvd, post.png. A failure
@@ -36,8 +36,8 @@ from pyhost.dumps import STREAM_ERRORS, DumpError, DumpReader, expand, open_text
 from pyhost.outdir import write_atomic
 from pyhost.output import VtkSeries
 from pyhost.scene import Material, SceneError, Wall, _build, read_toml
+from pyhost.walls import FACES
 
-PLANES = ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")
 MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
 MODELS = ("A", "B", "C")
 
@@ -80,7 +80,7 @@ def load_post_scene(path) -> PostScene:
                              f"known: {', '.join(materials)}")
         if bool(wall.fix) == bool(wall.plane):
             raise SceneError(f"{file}: walls[{k}]: give either fix (a LIGGGHTS wall fix id) or plane "
-                             f"({', '.join(PLANES)})")
+                             f"({', '.join(FACES)})")
     return PostScene(path, materials, types, [m.temperature for m in materials.values()], walls)
 
 
@@ -150,7 +150,6 @@ class Post:
         if self.dt is None:
             raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
         self.warnings = list(script.warnings) if script else []
-        self.unplaced = set()            # scene walls whose primitive plane post cannot place (warned)
         self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()
         self.positions = {}             # step -> (ids, x, box, periodic) of a few particle frames
@@ -184,16 +183,15 @@ class Post:
         """Pass over the particle dumps: particle table, frames, intervals; contacts from
         positions when there are no contact dumps."""
         found, first = Found(), FirstAppearances()
-        walls = [(k, w.plane) for k, w in enumerate(self.scene.walls) if w.plane]
-        primitive = {}                  # scene wall index -> (axis, position) of a script's primitive plane
+        walls = [(k, w.plane) for k, w in enumerate(self.scene.walls) if w.plane]  # box faces, primitive walls
         if not self.contacts:
-            planes = self.script.planes if self.script else {}
+            primitives = self.script.primitives if self.script else {}
             for k, w in enumerate(self.scene.walls):
-                if w.fix in planes:
-                    primitive[k] = planes[w.fix]
+                if w.fix in primitives:
+                    walls.append((k, primitives[w.fix]))
                 elif w.fix:
                     self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps (wall/gran/local), "
-                                         "or --script when it is a primitive plane; without them it is ignored")
+                                         "or --script when it is a primitive wall; without them it is ignored")
         steps, last = [], None
         for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
             ids, types = f["id"].astype(np.int64), f["type"].astype(int)
@@ -209,7 +207,7 @@ class Post:
             steps.append(f.step)
             last = f
             if not self.contacts:
-                self.position_contacts(f, ids, walls + self.box_faces(f, primitive), found, first, steps)
+                self.position_contacts(f, ids, walls, found, first, steps)
         self.summary["frames"] = len(steps)
         self.summary["particles"] = len(last) if last is not None else 0
         self.dump_steps = np.diff(steps).min() if len(steps) > 1 else None
@@ -220,29 +218,13 @@ class Post:
         """The frame's box (3, 2) [m]; a VTK dump has none: the script's (``--script``)."""
         return f.box if f.box is not None else (self.script.box if self.script else None)
 
-    def box_faces(self, f, primitive) -> list:
-        """(scene wall index, box face) of the script's primitive plane walls: a plane at a face
-        of the box is that face; one inside the box is not placed (warned once)."""
-        box, faces = self.frame_box(f), []
-        for k, (axis, position) in primitive.items():
-            if box is None:
-                continue
-            side = [abs(position - box[axis][e]) <= 1e-9 * max(1.0, abs(np.ptp(box[axis]))) for e in (0, 1)]
-            if any(side):
-                faces.append((k, "xyz"[axis] + ("lo" if side[0] else "hi")))
-            elif k not in self.unplaced:
-                self.unplaced.add(k)
-                self.warnings.append(f"wall fix {self.scene.walls[k].fix}: a plane at {position:g} m inside the box "
-                                     "is not placed by post; give --contacts dumps")
-        return faces
-
     def position_contacts(self, f, ids, walls, found, first, steps) -> None:
         if not len(f):
             first.new(np.empty(0, np.int64))
             return
         box = self.frame_box(f)
-        if walls and box is None:
-            raise ValueError(f"{f.file}: a VTK dump has no box, so plane walls cannot be placed: give --script "
+        if any(isinstance(w, str) for _, w in walls) and box is None:
+            raise ValueError(f"{f.file}: a VTK dump has no box, so walls on its faces cannot be placed: give --script "
                              "(its create_box), or use text dumps")
         x = f.positions()
         box = box if box is not None else np.stack([x.min(0) - 1.0, x.max(0) + 1.0], axis=1)

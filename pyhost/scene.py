@@ -54,6 +54,7 @@ import numpy as np
 from plugins.convection import CORRELATIONS
 from plugins.drag import LAWS as DRAG_LAWS
 from plugins.heat import MODEL_NAMES, MODELS
+from pyhost.walls import FACES
 
 
 class SceneError(ValueError):
@@ -152,7 +153,7 @@ class Particles:
 @dataclass(frozen=True)
 class Wall:
     material: str = spec(doc="key of [materials]")
-    plane: str = spec("in:,xlo,xhi,ylo,yhi,zlo,zhi", "", "which face of the box (box scenes)")
+    plane: str = spec("in:," + ",".join(FACES), "", "which face of the box (box scenes)")
     fix: str = spec(default="", doc="id of the script's fix wall/gran, primitive or mesh (script scenes)")
     temperature: float = spec(">=0", 0.0, "fixed temperature [K] (for collisions; with effects.convection also "
                                            "the gas at that side of a box scene); 0 means adiabatic")

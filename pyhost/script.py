@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pyhost.dumps import LOCAL_DEFAULT, LOCAL_GROUPS
+from pyhost.walls import PRIMITIVES
 
 REFUSED = {
     "jump": "loops and jumps need LIGGGHTS' own input loop",
@@ -229,9 +230,6 @@ class GranWall:
     meshes: tuple = ()
     type: int | None = None
     moving: bool = False
-
-
-PRIMITIVES = {"xplane": 1, "yplane": 1, "zplane": 1, "xcylinder": 3, "ycylinder": 3, "zcylinder": 3}
 
 
 def parse_wall(cmd: Command) -> GranWall | None:

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pyhost.scene import SceneError
+from pyhost.walls import face_axis, face_gap
 
 MAX_IDS = 2**31 - 1             # LIGGGHTS' atom ids are 32-bit signed integers
 BYTES_PER_PARTICLE = 2000       # LIGGGHTS' per-atom arrays, neighbour lists, the host's copies
@@ -122,7 +123,7 @@ def check_scene(scene) -> None:
     if scene.scripted:          # the script places the particles and sets the box and the step
         return
     for k, w in enumerate(scene.walls):
-        if d.periodic[AXES.index(w.plane[0])]:
+        if d.periodic[face_axis(w.plane)[0]]:
             raise SceneError(f"{file}: walls[{k}].plane: {w.plane!r} lies on the periodic axis {w.plane[0]} "
                              f"(domain.periodic = {d.periodic})")
     if scene.output.every < tm.dem_step:
@@ -170,10 +171,8 @@ def _where(scene, i) -> str:
 
 
 def _walls_clear(scene, p) -> None:
-    box = scene.domain.box
     for w in scene.walls:
-        a, side = AXES.index(w.plane[0]), w.plane.endswith("hi")
-        gap = (box[2 * a + 1] - p.position[:, a]) if side else (p.position[:, a] - box[2 * a])
+        gap = face_gap(p.position, w.plane, scene.domain.box)
         i = int(np.argmin(gap - p.radius))
         if gap[i] < p.radius[i] * (1 - OVERLAP_TOLERANCE):
             raise SceneError(f"{scene.path}: {_where(scene, i)}: overlaps the wall {w.plane} by "

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from pyhost.collisions import WALL_BASE
+from pyhost.walls import plane_of, primitive_overlap
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.ranks import (collective, gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_values, put_by_id, set_random_states, write_local)
@@ -434,7 +435,7 @@ class Dem:
         contact codes."""
         primitive = [(w.primitive, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items()
                      if w.primitive is not None]
-        planes = [("xyz".index(kind[0]), num[0], code) for (kind, num), code in primitive if kind.endswith("plane")]
+        planes = [(*plane_of(p), code) for p, code in primitive if plane_of(p)]
         self.events.planes(*(zip(*planes) if planes else ([], [], [])))
         cylinders = [("xyz".index(kind[0]), *num[:3], code) for (kind, num), code in primitive
                      if kind.endswith("cylinder")]
@@ -528,25 +529,8 @@ class Dem:
 
 
 def _primitive_contacts(atoms: Atoms, primitive, wall: int) -> Contacts:
-    """Contacts with a fixed primitive wall from geometry: plane ``xplane p`` (etc.) or
-    cylinder ``zcylinder R c1 c2`` (etc.), overlap = radius - distance to the surface."""
-    kind, num = primitive
-    axis = "xyz".index(kind[0])
-    x, r = atoms.x, atoms.radius
-    if kind.endswith("plane"):
-        s = x[:, axis] - num[0]
-        delta = r - np.abs(s)
-        normal = np.zeros((len(x), 3))
-        normal[:, axis] = np.where(s >= 0, 1.0, -1.0)
-    else:
-        other = [k for k in range(3) if k != axis]
-        rad = x[:, other] - np.array(num[1:3])
-        dist = np.linalg.norm(rad, axis=1)
-        unit = rad / np.where(dist > 0, dist, 1.0)[:, None]
-        inside = dist < num[0]
-        delta = r - np.where(inside, num[0] - dist, dist - num[0])
-        normal = np.zeros((len(x), 3))
-        normal[:, other] = np.where(inside[:, None], -unit, unit)
+    """Contacts with a fixed primitive wall (``pyhost.walls.primitive_overlap``)."""
+    delta, normal = primitive_overlap(atoms.x, atoms.radius, primitive)
     on = np.flatnonzero(delta > 0)
     return Contacts(atoms.id[on], np.full(len(on), wall, np.int64), delta[on], normal[on],
                     -np.einsum("ij,ij->i", atoms.v[on], normal[on]), np.zeros(len(on)))

@@ -32,6 +32,7 @@ from typing import Iterable
 import numpy as np
 
 from pyhost.exitcodes import SimulationFailed
+from pyhost.walls import primitive_overlap
 
 LIB = "libliggghts.so.3"
 _ISOLATED = "OMPI_MCA_ess_singleton_isolated"
@@ -482,8 +483,8 @@ class Liggghts:
         for x, y, z; m), from geometry: overlap radius - distance (m), area of the cut
         circle pi (2 r delta - delta^2) (m^2), as LIGGGHTS reports for mesh walls; ``j`` is
         ``wall``, ``vj`` zero."""
-        x, r, v = self.atom("x"), self.atom("radius"), self.atom("v")
-        delta = r - np.abs(x[:, axis] - position)
+        r, v = self.atom("radius"), self.atom("v")
+        delta, _ = primitive_overlap(self.atom("x"), r, ("xyz"[axis] + "plane", (position,)))
         on = delta > 0
         return Contacts(i=self.atom("id")[on].astype(np.int64), j=np.full(on.sum(), wall),
                         delta=delta[on], vi=v[on].copy(), vj=np.zeros((on.sum(), 3)),

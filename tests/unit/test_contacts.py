@@ -62,3 +62,31 @@ def test_verlet_list_never_misses_a_contact():
         fresh = find_contacts(x, np.zeros_like(x), r, BOX, periodic=(True, True, False), walls=("zlo",))
         assert sorted(zip(got.i, got.j)) == sorted(zip(fresh.i, fresh.j))
     assert 1 < finder.rebuilds < 60
+
+
+def test_primitive_plane_on_a_face_equals_the_face_bit_for_bit():
+    """A script's primitive plane at a box face (two-sided) and the scene's face (one-sided)
+    give the same overlap, normal and approach for every particle inside the box: post
+    places the script's planes as primitives, box scenes as faces (pyhost.walls)."""
+    rng = np.random.default_rng(3)
+    x, v, r = rng.uniform(0.01, 0.99, (400, 3)), rng.normal(size=(400, 3)), rng.uniform(0.01, 0.05, 400)
+    for face, primitive in (("zlo", ("zplane", (0.0,))), ("xhi", ("xplane", (1.0,)))):
+        a = find_contacts(x, v, r, BOX, walls=(face,))
+        b = find_contacts(x, v, r, BOX, walls=(primitive,))
+        assert len(a) > 5
+        for name in ("i", "j", "delta", "normal", "approach"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), (face, name)
+
+
+def test_cylinder_wall_inside_and_outside():
+    """zcylinder of radius 0.3 m about (0.5, 0.5): a 0.05 m sphere 0.28 m from the axis
+    overlaps it by 0.03 m from inside (normal towards the axis); one 0.33 m from the axis by
+    0.02 m from outside (normal away from it); one 0.1 m from the axis touches nothing."""
+    x = np.array([[0.78, 0.5, 0.5], [0.5, 0.17, 0.2], [0.6, 0.5, 0.5]])
+    v = np.array([[2.0, 0, 0], [0, 1.0, 0], [0, 0, 0]])
+    c = find_contacts(x, v, np.full(3, 0.05), BOX, walls=(("zcylinder", (0.3, 0.5, 0.5)),))
+    assert sorted(c.i.tolist()) == [0, 1] and set(c.j.tolist()) == {WALL_BASE}
+    k = list(c.i).index(0)
+    assert c.delta[k] == pytest.approx(0.03) and np.allclose(c.normal[k], [-1, 0, 0]) and c.approach[k] == pytest.approx(2.0)
+    k = list(c.i).index(1)
+    assert c.delta[k] == pytest.approx(0.02) and np.allclose(c.normal[k], [0, -1, 0]) and c.approach[k] == pytest.approx(1.0)

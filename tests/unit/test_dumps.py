@@ -233,3 +233,15 @@ def test_a_dump_cut_inside_a_keywords_columns_is_an_error(tmp_path):
     frames = list(DumpReader([tmp_path / "l"], computes={"c": Compute("c", "pair/gran/local",
                                                                       ("vel", "id", "contactArea", "delta"))}))
     assert frames[0].groups["id_i"] == 6 and frames[0].data[0, 6] == 1
+
+
+def test_script_primitive_walls_are_read_with_their_numbers(tmp_path):
+    """post places a script's primitive walls from its own numbers (pyhost.walls): planes and
+    cylinders with literal numbers; one given by a variable cannot be placed and is left out."""
+    script = tmp_path / "in.walls"
+    script.write_text("timestep 1e-5\n"
+                      "fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n"
+                      "fix drum all wall/gran model hertz tangential history primitive type 1 zcylinder 0.05 0. 0.\n"
+                      "fix lid all wall/gran model hertz tangential history primitive type 1 zplane ${top}\n"
+                      "fix cut all wall/gran model hertz tangential history primitive type 1 xcylinder 0.05\n")
+    assert read_script(script).primitives == {"floor": ("zplane", (0.0,)), "drum": ("zcylinder", (0.05, 0.0, 0.0))}
