@@ -17,7 +17,7 @@ import sys
 from pyhost.exitcodes import UserError, classify  # noqa: F401  (UserError: for the commands)
 from pyhost.signals import stopping
 
-COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "bench", "post", "compare",
+COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "post", "compare",
             "collisions")
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from plugins.dem.hertz import effective_modulus, hertz_collision_time
-from pyhost.scene import Scene, SceneError
+from pyhost.schema import Scene, SceneError
 from pyhost.walls import face_primitive
 
 
@@ -175,7 +175,7 @@ def script_dem_contacts(scene, dem) -> list:
     material with neither a type nor a wall keeps its table (None: never needed)."""
     import dataclasses
 
-    from pyhost.scene import DemContact
+    from pyhost.schema import DemContact
     from pyhost.script import ScriptError
 
     wall_of = {}

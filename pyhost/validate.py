@@ -18,7 +18,7 @@ import os
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pyhost.scene import SceneError
+from pyhost.schema import SceneError
 from pyhost.walls import face_axis, face_gap
 
 MAX_IDS = 2**31 - 1             # LIGGGHTS' atom ids are 32-bit signed integers

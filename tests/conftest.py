@@ -96,7 +96,7 @@ dem = {dem}
 
 def steel_material(dem=None):
     """The same steel as a pyhost.scene.Material (DEM contact: 1e7 Pa, e = 0.9 unless given)."""
-    from pyhost.scene import DemContact, Material
+    from pyhost.schema import DemContact, Material
     return Material(7800.0, 210e9, 0.3, 300e6, 470.0, 45.0, dem or DemContact(youngs_modulus=1e7, restitution=0.9))
 
 

@@ -13,8 +13,7 @@ Errors: max and median relative error of e (physical collisions only), t_coll an
 Cost: seconds per collision, median and spread (min-max) over --repeats timings;
 vectorised paths are timed on 1e6 collisions.
 
-Run: .venv/bin/python tools/bench_accuracy.py [--out docs] [--repeats 5]
-(also ``python -m pyhost bench accuracy``).
+Run: .venv/bin/python tools/bench_accuracy.py [--out docs] [--repeats 5] [--n 40]
 """
 from __future__ import annotations
 

@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from plugins.heat import MODEL_NAMES  # noqa: E402
-from pyhost import scene as S  # noqa: E402
+from pyhost import schema as S  # noqa: E402
 
 SECTIONS = (
     ("[dem]", S.Dem, "A user's own LIGGGHTS script. With it, [[particles]] and [domain] are not used: "

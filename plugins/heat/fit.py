@@ -31,7 +31,7 @@ beta^(5/8) v_hat^(-1/4), which is Johnson's (1985) v0^(-1/4) law with his
 e is clipped to at most 1 (the models give e > 1 in their unphysical ranges, see
 ``exact.flags_for``); the fit of e is stated for the physical range only.
 
-Constants (``CONSTANTS``) come from ``python -m pyhost fit`` (tools/fit_relations.py):
+Constants (``CONSTANTS``) come from ``python -m pyhost fit`` (``plugins.heat.refit``):
 least squares on ln(y) over a design of 2400 exact collisions, random materials, sizes,
 walls, b1 in [1.0, 1.2], b2/b1 in [1.4, 4], v0/v_y log-uniform in [1, 1e5].
 

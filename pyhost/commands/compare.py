@@ -40,7 +40,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def material(name: str, dem_modulus: float):
-    from pyhost.scene import DemContact, Material
+    from pyhost.schema import DemContact, Material
     rho, E, nu, Y, c, k = MATERIALS[name]
     return Material(rho, E, nu, Y, c, k, DemContact(youngs_modulus=float(dem_modulus),
                                                     restitution=DEM_RESTITUTION, poisson_ratio=nu))

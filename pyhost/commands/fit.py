@@ -1,26 +1,16 @@
 """``python -m pyhost fit``: rebuild the fitted relations of ``plugins.heat.fit``.
 
 Runs the exact path over a random design of materials, sizes, walls and speeds
-(tools/fit_relations.py), fits the constants with scipy, and prints them (as the Python
+(``plugins.heat.refit``), fits the constants with scipy, and prints them (as the Python
 literal that ``plugins/heat/fit.py`` holds), the max and RMS relative errors of the fitted
 and of the shipped constants, and Johnson's and Thornton's e on the same points.
 """
 from __future__ import annotations
 
 import argparse
-import importlib.util
 from pathlib import Path
 
 HELP = "rebuild the fitted relations for e, t_coll and Q (constants, errors, validity)"
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def load_tool(name: str):
-    """A module of tools/ by file path (tools/ is scripts, not a package)."""
-    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -33,10 +23,10 @@ def run(args) -> int:
     import numpy as np
 
     from plugins.heat import fit as F
+    from plugins.heat import refit as FR
 
     if args.n < 10:
         raise ValueError(f"--n must be at least 10, got {args.n}")
-    FR = load_tool("fit_relations")
     hi = F.VALIDITY["v_hat"][1]
     print(f"design: {args.n} random pairs x models A, B, C by the exact path, "
           f"v0/v_y log-uniform in [1, {hi:g}], b1 in {F.VALIDITY['b1']}, b2/b1 in {F.VALIDITY['beta']}")

@@ -27,7 +27,8 @@ import numpy as np
 from pyhost.collisions import WALL_BASE
 from pyhost.walls import plane_of, primitive_overlap
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
-from pyhost.engines.ranks import (collective, gather_arrays, local_atoms, local_atoms_of, local_random_states,
+from pyhost.engines.collective import collective
+from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_values, put_by_id, set_random_states, write_local)
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
 

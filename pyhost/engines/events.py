@@ -27,7 +27,7 @@ import ctypes
 
 import numpy as np
 
-from pyhost.engines.ranks import collective
+from pyhost.engines.collective import collective
 
 FIX = "collheat_events"
 ROW = 12

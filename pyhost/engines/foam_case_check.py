@@ -19,7 +19,7 @@ from pathlib import Path
 
 from foamlib import FoamFile
 
-from pyhost.scene import SceneError
+from pyhost.schema import SceneError
 
 #: patch types OpenFOAM also puts in a group of that name (#includeEtc setConstraintTypes
 #: gives each of these its field entry)

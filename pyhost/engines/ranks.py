@@ -167,26 +167,6 @@ class Link:
         self.comm.Abort(code)
 
 
-def collective(method):
-    """A method of rank 0 that makes collective calls: an error inside it leaves the
-    followers possibly waiting in another call, so the link is marked broken (the run then
-    ends through MPI_Abort, pyhost.commands.run)."""
-    import functools
-
-    @functools.wraps(method)
-    def wrapper(self, *args, **kwargs):
-        from pyhost.engines.liggghts import LiggghtsFailed
-        try:
-            return method(self, *args, **kwargs)
-        except LiggghtsFailed:
-            raise                 # every rank's LIGGGHTS returned with it (Error::all): still in step
-        except BaseException:
-            if self.link is not None:
-                self.link.broken = True
-            raise
-    return wrapper
-
-
 class Follower:
     """A rank other than 0: does what rank 0 orders, until ``close``."""
 

@@ -11,7 +11,7 @@ from scipy.special import betainc
 from plugins.heat import MODEL_NAMES, Pair, collide
 from plugins.heat.comparison import COMPARISON, DemPair, get_comparison
 from plugins.heat.batch import dem_pair, evaluate, pair_properties, side_heat
-from pyhost.scene import DemContact, Material
+from pyhost.schema import DemContact, Material
 
 STEEL = steel_material()
 ALU = Material(2700.0, 70e9, 0.33, 100e6, 900.0, 200.0, DemContact(youngs_modulus=5e7, restitution=0.6,

@@ -8,7 +8,7 @@ from conftest import steel_material
 from plugins.heat import Pair, collide
 from plugins.dem.impulse import restitution_impulse
 from plugins.heat.batch import evaluate, evaluate_flagged, pair_properties
-from pyhost.scene import DemContact, Material
+from pyhost.schema import DemContact, Material
 
 DEM = DemContact(youngs_modulus=1e7, restitution=0.9)
 STEEL = steel_material(DEM)

@@ -1,0 +1,82 @@
+"""The data flows one way (issue 22): plugins/ (the physics) imports nothing of the host,
+pyhost/ nothing of tools/ (scripts that import pyhost), and no module of either reaches
+itself again through its imports, counting those inside functions."""
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def modules() -> dict:
+    """{dotted name: file} of every module of pyhost/ and plugins/."""
+    found = {}
+    for package in ("pyhost", "plugins"):
+        for f in (ROOT / package).rglob("*.py"):
+            parts = f.relative_to(ROOT).with_suffix("").parts
+            found[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = f
+    return found
+
+
+def imports(f: Path) -> set:
+    """Every module name an import statement of the file names (module level or not)."""
+    names = set()
+    for node in ast.walk(ast.parse(f.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            names |= {node.module} | {f"{node.module}.{a.name}" for a in node.names}
+        elif isinstance(node, ast.Import):
+            names |= {a.name for a in node.names}
+    return names
+
+
+def graph() -> dict:
+    mods = modules()
+    return {name: {m for m in imports(f) if m in mods and m != name} for name, f in mods.items()}
+
+
+def cycles(g: dict) -> list:
+    """The strongly connected components of more than one module (Tarjan)."""
+    index, low, stack, on, found = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in sorted(g[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while not comp or comp[-1] != v:
+                comp.append(stack.pop())
+                on.discard(comp[-1])
+            if len(comp) > 1:
+                found.append(sorted(comp))
+
+    for v in sorted(g):
+        if v not in index:
+            visit(v)
+    return found
+
+
+def test_the_finder_sees_a_cycle():
+    assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert cycles({"a": {"b"}, "b": set()}) == []
+
+
+def test_no_import_cycles():
+    g = graph()
+    assert len(g) > 80 and g["pyhost.loop"]          # the walk found the tree
+    assert cycles(g) == []
+
+
+def test_plugins_import_nothing_of_the_host_and_the_host_nothing_of_tools():
+    mods = modules()
+    upward = {name: sorted(m for m in imports(f) if m.split(".")[0] == "pyhost")
+              for name, f in mods.items() if name.startswith("plugins")}
+    assert {k: v for k, v in upward.items() if v} == {}
+    tools = {name: sorted(m for m in imports(f) if m.split(".")[0] == "tools") for name, f in mods.items()}
+    assert {k: v for k, v in tools.items() if v} == {}
+    assert not [name for name, f in mods.items() if "spec_from_file_location" in f.read_text()]
