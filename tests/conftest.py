@@ -152,7 +152,7 @@ def pytest_collection_modifyitems(config, items):
 # name: SIGTERM, SIGKILL, ...) after the first chunk that reaches STEP (a batch system's stop).
 STOPPER = """
 import os, signal, sys
-import pyhost.commands.run as r
+import pyhost.world as r
 from pyhost.cli import main
 at, sig = int(sys.argv[1]), getattr(signal, sys.argv[2])
 class Stopping:

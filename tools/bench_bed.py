@@ -62,7 +62,7 @@ from pathlib import Path
 import numpy as np
 
 from bench_host import Clocked
-from pyhost.commands.run import simulate, start_fluid
+from pyhost.world import simulate, start_fluid
 from pyhost.dem_input import place_particles
 from pyhost.loop import layer_pressure_drop
 from pyhost.output import read_collisions

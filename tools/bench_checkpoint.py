@@ -61,7 +61,7 @@ def main() -> None:
 
     case = Path(args.case).resolve()
     scene = load_scene(case / "case.toml")
-    end = scene.time.test_end or scene.time.end / 10          # what --test runs (pyhost.commands.run)
+    end = scene.time.test_end or scene.time.end / 10          # what --test runs (pyhost.commands.run.run_case)
     every = end / (args.count + 0.5)          # not at the end: the last one would not be a periodic cost
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

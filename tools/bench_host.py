@@ -116,7 +116,10 @@ class Clocked:
 def run_host(scene, out: Path, whole: bool = False):
     """Wall time [s] of the coupled run from its first DEM step to its summary (``whole``:
     with the engines' set-up), and the summary."""
-    from pyhost.commands.run import simulate         # here: bench_host_baseline imports this file
+    try:                                      # here: bench_host_baseline imports this file
+        from pyhost.world import simulate
+    except ImportError:                       # a checkout before pyhost/world.py
+        from pyhost.commands.run import simulate
 
     clocked = {}
 
@@ -210,11 +213,12 @@ def main() -> None:
 
 def baseline_sizes(tree: Path, sizes, sim_time: float, repeat: int) -> list[dict]:
     """Section 4 on the code of another checkout (CSV log), in a process of its own: this
-    script itself for a checkout with ``pyhost.commands.run.simulate``, else
-    ``bench_host_baseline.py`` (the code before the LIGGGHTS-script rewrite)."""
+    script itself for a checkout with ``simulate`` (``pyhost.world``, earlier
+    ``pyhost.commands.run``), else ``bench_host_baseline.py`` (the code before the
+    LIGGGHTS-script rewrite)."""
     env = dict(os.environ, PYTHONPATH=str(tree.resolve()))
-    current = "def simulate(" in (tree / "pyhost" / "commands" / "run.py").read_text() \
-        if (tree / "pyhost" / "commands" / "run.py").is_file() else False
+    current = any("def simulate(" in f.read_text() for f in (tree / "pyhost" / "world.py",
+                                                               tree / "pyhost" / "commands" / "run.py") if f.is_file())
     cmd = ([sys.executable, __file__, "--rows-json", "--size-time", str(sim_time), "--repeat", str(repeat),
             "--particles"] + [str(n) for n in sizes] if current else
            [sys.executable, str(Path(__file__).with_name("bench_host_baseline.py")), str(sim_time), str(repeat)]

@@ -82,7 +82,7 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
     """One run (under mpirun or not); rank 0 prints one JSON line. ``n`` > 0: the grown gas
     with ``n`` particles; ``n`` = 0: the case in the environment variable BENCH_CASE as it is,
     for ``sim_time`` s."""
-    from pyhost.commands.run import simulate
+    from pyhost.world import simulate
     from pyhost.engines.ranks import Follower, Link, world
     from pyhost.scene import load_scene
 

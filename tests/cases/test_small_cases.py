@@ -104,7 +104,7 @@ class Interrupting:
 
 
 def test_results_so_far_survive_a_failure(tmp_path):
-    from pyhost.commands.run import simulate
+    from pyhost.world import simulate
 
     scene = load_scene(CASES / "hot-cold-box" / "case.toml")
     with pytest.raises(RuntimeError, match="diverged"):

@@ -37,7 +37,7 @@ def test_isothermal_scene_adds_and_samples_nothing(tmp_path):
 REFERENCE = """
 import json, sys
 from pathlib import Path
-from pyhost.commands.run import box_world
+from pyhost.world import box_world
 from pyhost.engines.dem import Dem
 from pyhost.scene import load_scene
 from pyhost.script import read_script
@@ -125,7 +125,7 @@ def restart_run(workdir, touching: bool) -> list:
     heat moved [J], final velocities [m/s] (by id)."""
     import dataclasses
 
-    from pyhost.commands.run import simulate
+    from pyhost.world import simulate
     from pyhost.dem_input import place_particles
 
     case = Path(workdir) / "case.toml"

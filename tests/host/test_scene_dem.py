@@ -19,7 +19,7 @@ SCRIPT = """
 import json, sys
 import numpy as np
 from pathlib import Path
-from pyhost.commands.run import box_world
+from pyhost.world import box_world
 from pyhost.engines.dem import FLUID_FIX, Dem
 from pyhost.scene import load_scene
 from pyhost.script import read_script

@@ -173,7 +173,7 @@ def no_engine(monkeypatch):
     def started(*args, **kwargs):
         raise AssertionError("an engine was started")
     monkeypatch.setattr("pyhost.engines.dem.Dem", started)
-    monkeypatch.setattr("pyhost.commands.run.start_fluid", started)
+    monkeypatch.setattr("pyhost.world.start_fluid", started)
 
 
 @pytest.mark.parametrize("name", SCENES)

@@ -52,7 +52,7 @@ def test_copy_of_a_case_holding_runs_leaves_them_out(case):
     solver's later times or processor folders."""
     import shutil
 
-    from pyhost.commands.run import _case_copy_filter
+    from pyhost.world import _case_copy_filter
     (case / "case.toml").write_text("")
     for old in ("old-run", "output"):
         (case / old / "fluid").mkdir(parents=True)

@@ -1,0 +1,239 @@
+"""World assembly: from a loaded scene to running engines and the loop that couples them.
+
+``simulate`` is the one entry: it builds the DEM (the user's LIGGGHTS script, or the box
+world a box scene describes: particles placed, walls, the LIGGGHTS input written), starts the
+fluid solver only when the scene has a fluid (a box case, or the user's OpenFOAM case copied
+and meshed), and hands both to ``pyhost.loop.run_scene``. The ``run`` command, the tests and
+the benchmarks call it; it prints nothing of its own but warnings.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+
+def _case_copy_filter(target: Path):
+    """What a copy of a user's OpenFOAM case leaves out: earlier solver output (time folders
+    other than 0, processor folders, logs, the pipes) and the run's own output folder, which
+    lies inside the case when case.toml sits in it (``case = "."``, CFDEM's layout), as do
+    earlier runs' output folders (holding scene.json) written with another --out."""
+    target = Path(target).resolve()
+    solver_output = shutil.ignore_patterns("processor*", ".link", "log.*", "[1-9]*", "0.[0-9]*")
+
+    def ignore(folder, names):
+        here = Path(folder).resolve()
+        return set(solver_output(folder, names)) | {n for n in names if target.is_relative_to(here / n)
+                                                     or (here / n / "scene.json").is_file()}
+    return ignore
+
+
+def start_fluid(scene, folder: Path, restart: Path | None = None):
+    """The scene's fluid (``restart``: a checkpoint's saved fluid to continue from): a box case (pyhost.engines.fluid_case) over the domain and the plenum below
+    it, inlet at its z lo, outlet at z hi, solved by collheatFoam every time.couple_every DEM
+    steps. The inlet value is the fluid velocity there, so the superficial velocity asked for
+    needs a particle-free inlet (a plenum) to be met. With convection the gas has a
+    temperature: the scene's initial and inlet temperatures, walls of the scene's [[walls]]
+    on the box's sides at their fixed temperature, the other walls adiabatic."""
+    from foamlib import FoamFile
+
+    from pyhost.engines.fluid_case import add_final_solvers, adopt_void_fraction, box_case, case_density
+    from pyhost.engines.openfoam import FluidSolver
+
+    f = scene.fluid
+    energy = scene.effects.convection != "none"
+    if f.case:                          # the user's own case, copied: the host never writes into it
+        source = (scene.folder / f.case).resolve()
+        shutil.rmtree(folder, ignore_errors=True)
+        shutil.copytree(source, folder, symlinks=True, ignore=_case_copy_filter(folder))
+        adopt_void_fraction(folder)
+        add_final_solvers(folder)
+        props = FoamFile(folder / "constant" / "transportProperties")
+        rho, where = case_density(folder)
+        if where.startswith("0/rho"):   # collheatFoam reads rho beside nu
+            props["rho"] = FoamFile.Dimensioned(name="rho", value=rho, dimensions=[1, -3, 0, 0, 0, 0, 0])
+        if energy:                      # the gas's properties are the scene's, given once
+            props.update({"Cp": f.heat_capacity, "kappa": f.conductivity})
+        _mesh(folder, source, str(scene.path))
+        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
+                           void_fraction=f.void_fraction, restart=restart).start()
+    box = scene.domain.box
+    boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
+    inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
+             else ("inlet", (0.0, 0.0, f.inlet_velocity)))
+    boundaries.update(zlo=inlet, zhi="outlet")
+    lo = [box[0], box[2], box[4] - f.plenum]
+    sides = {w.plane: w.temperature for w in scene.walls if w.plane in boundaries and w.temperature > 0}
+    case = box_case(folder, lo=lo, hi=box[1::2], cells=f.cells, boundaries=boundaries, rho=f.density,
+                    nu=f.viscosity / f.density, gravity=scene.domain.gravity,
+                    dt=scene.time.couple_every * scene.time.dem_step,
+                    T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
+                    T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
+    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
+                       void_fraction=f.void_fraction, restart=restart).start()
+
+
+def _mesh(case: Path, source: Path, file: str) -> None:
+    """blockMesh on the copied case unless it has a mesh: a blockMeshDict that blockMesh
+    refuses is bad input (SceneError) with blockMesh's own words."""
+    from pyhost.engines.openfoam import FluidError, run_utility
+    from pyhost.scene import SceneError
+
+    if (case / "constant" / "polyMesh" / "owner").is_file():
+        return
+    try:
+        run_utility(case, "blockMesh")
+    except FluidError:
+        log = [line.strip() for line in (case / "log.blockMesh").read_text(errors="replace").splitlines()]
+        fatal = next((k for k, line in enumerate(log) if "FOAM FATAL" in line), len(log) - 2)
+        said = []
+        for line in log[fatal + 1:]:
+            if line.startswith(("From ", "FOAM aborting", "FOAM exiting", "#0")):
+                break
+            said += [line] if line else []
+        words = "; ".join(said)
+        raise SceneError(f"{file}: fluid.case: {source / 'system/blockMeshDict'}: blockMesh refuses it: "
+                         f"{words}") from None
+
+
+def box_world(scene, out: Path, start=None, restart: Path | None = None):
+    """The generated DEM of a box scene: its script (run for time.end) and how the host sees
+    its particles: one atom type per material, groups = the [[particles]] tables, walls
+    ``wall<k>`` = the scene's [[walls]]. ``start``: the particles (``pyhost.dem_input.Particles``,
+    e.g. a settled bed) to start from instead of the scene's placement; the contacts present
+    then are not collisions of this run. ``restart``: LIGGGHTS' restart file of a checkpoint
+    to read instead of the particles (the same commands re-issued, with the same ids)."""
+    from pyhost.dem_input import input_lines, place_particles, write_data
+    from pyhost.loop import HostWall
+
+    folder = out / "dem"
+    folder.mkdir(parents=True, exist_ok=True)
+    particles = place_particles(scene) if start is None else start
+    steps = round(scene.time.end / scene.time.dem_step)
+    if restart is None:
+        data = write_data(folder / "particles.data", scene, particles)
+        script, lines, run = folder / "in.dem", input_lines(scene, data), f"run {steps}"
+    else:
+        script, run = folder / "in.restart", f"run {steps} upto"
+        lines = [f"read_restart {restart}" if line.startswith("read_data ") else line
+                 for line in input_lines(scene, Path("-"))]
+    script.write_text("\n".join(["atom_modify sort 0 0"] + lines + [run]) + "\n")
+    index = {name: k for k, name in enumerate(scene.materials)}
+    T_by_id = np.r_[np.nan, particles.temperature]
+    group_by_id = np.r_[-1, particles.group]
+    names = [f"{g.material} {g.temperature:g} K" for g in scene.particles]
+    walls = [HostWall(f"wall{k}", index[w.material], w.temperature if w.temperature > 0 else np.nan)
+             for k, w in enumerate(scene.walls)]
+    return script, dict(type_material=[-1] + list(range(len(index))),
+                        groups=(names, lambda atoms: group_by_id[atoms.id]),
+                        initial_T=lambda atoms, new: T_by_id[atoms.id[new]],
+                        walls_of=lambda dem: walls, keep_all=group_by_id)
+
+
+def user_script(scene):
+    """How the host sees the particles of a user's script: each atom type's material from
+    [materials.NAME] types, groups = materials, walls = the scene's [[walls]] (by fix id) and
+    every other wall/gran fix of the script as an adiabatic wall."""
+    from pyhost.loop import HostWall
+    from pyhost.scene import SceneError
+
+    names = list(scene.materials)
+    used = {w.material for w in scene.walls}
+    for name, m in scene.materials.items():
+        if not m.types and name not in used:
+            raise SceneError(f"{scene.path}: materials.{name}.types: the material is used by no atom type "
+                             "and no wall")
+    top = max((t for m in scene.materials.values() for t in m.types), default=0)
+    type_material = np.full(top + 1, -1)
+    for k, m in enumerate(scene.materials.values()):
+        type_material[m.types] = k
+    T_material = np.array([m.temperature if m.temperature > 0 else np.nan for m in scene.materials.values()])
+
+    told = set()
+
+    def walls_of(dem):
+        known = dem.info.walls
+        named = {}
+        for k, w in enumerate(scene.walls):
+            if w.fix not in known:
+                raise SceneError(f"{scene.path}: walls[{k}].fix: the script has no fix wall/gran {w.fix!r} "
+                                 f"before its first run; its walls: {', '.join(known) or 'none'}")
+            named[w.fix] = (names.index(w.material), w.temperature if w.temperature > 0 else np.nan)
+        for fix in known:
+            if fix not in named and fix not in told:
+                print(f"LIGGGHTS wall {fix!r} has no [[walls]] entry: adiabatic for collision heat")
+        mesh = [f for f, w in known.items() if w.meshes]
+        if len(mesh) > 1 and not told.issuperset(known):
+            print(f"warning: LIGGGHTS lists the contacts of one mesh wall fix only ({mesh[-1]!r}); "
+                  f"collisions with {', '.join(mesh[:-1])} are not seen")
+        told.update(known)
+        return [HostWall(f, *named.get(f, (-1, np.nan)), mesh=k)
+                for f, wall in known.items() for k in range(max(len(wall.meshes), 1))]
+
+    return dict(type_material=type_material,
+                groups=(names, lambda atoms: type_material[np.minimum(atoms.type, top)]),
+                initial_T=lambda atoms, new: T_material[type_material[np.minimum(atoms.type[new], top)]],
+                walls_of=walls_of)
+
+
+def driven_time(scene) -> float:
+    """How long [s] a CFD-DEM script's final ``run 0`` lasts (the coupling drives it, as in
+    CFDEM's scripts): [time] end if the scene gives it, else the fluid case's controlDict
+    endTime less its startTime."""
+    from foamlib import FoamFile
+
+    if scene.time.end > 0:
+        return scene.time.end
+    control = FoamFile(scene.folder / scene.fluid.case / "system" / "controlDict")
+    return float(control["endTime"]) - float(control.get("startTime", 0.0))
+
+
+def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None, wrap_fluid=None,
+             start=None, resume: dict | None = None, link=None) -> dict:
+    """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
+    world, with the fluid if the scene has one. ``wrap(dem)`` and ``wrap_fluid(fluid)`` may
+    stand in front of the engines (tests inject faults, benchmarks record with them);
+    ``start``: the particles a box scene starts from (see ``box_world``); ``resume``: the state of
+    a checkpoint to continue from (``pyhost.checkpoint.load``); ``link``: the other MPI ranks'
+    LIGGGHTS (``pyhost.engines.ranks``), None when serial. Returns the summary."""
+    from pyhost.engines.dem import Dem
+    from pyhost.dem_input import dem_collision_time
+    from pyhost.loop import run_scene
+    from pyhost.script import check_types, read_script
+
+    effects = scene.effects_summary()
+    driven = driven_time(scene) if scene.scripted and effects["fluid_solver"] else None
+    max_time = (scene.time.test_end or (driven / 10 if driven else None)) if (test and scene.scripted) else None
+    if scene.scripted:
+        script, particles = scene.folder / scene.dem.script, user_script(scene)
+        variables = dict(scene.dem.variables, **(scene.dem.test_variables if test else {}))
+    else:
+        t_c = dem_collision_time(scene, 1.0)
+        if scene.time.dem_step > t_c / 20:
+            print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
+                  f"({t_c:.3g} s) with fewer than 20 steps")
+        script, particles = box_world(scene, out, start, resume and resume["restart"])
+        variables = {}
+    particles["resume"] = resume
+    commands = read_script(script, scene.folder)
+    if scene.scripted:
+        check_types(commands, scene.materials, str(scene.path))
+    fluid = start_fluid(scene, out / "fluid", resume and resume["fluid"]) if effects["fluid_solver"] else None
+    cwd = os.getcwd()
+    try:
+        os.chdir(scene.folder)          # the script's relative paths, as with 'liggghts -in' there
+        dem = Dem(out / "dem", variables=variables, link=link)
+        try:
+            return run_scene(scene, wrap(dem) if wrap else dem, commands, out, max_time=max_time,
+                             fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
+                             end=None if scene.scripted else scene.time.end, driven=driven,
+                             progress_every=progress_every,
+                             **particles)
+        finally:
+            dem.close()
+    finally:
+        os.chdir(cwd)
+        if fluid is not None:
+            fluid.stop()
