@@ -784,7 +784,7 @@ class Coupling:
         for key, share in convection.outside(name, re, pr, alpha).items():
             if key not in self.warned:
                 self.warned.add(key)
-                lo, hi = convection.get(name).validity[key]
+                lo, hi = convection.CORRELATIONS.lookup(name).validity[key]
                 print(f"warning: convection '{name}' extrapolated: {share:.1%} of the particles have {key} outside "
                       f"[{lo:g}, {hi:g}] at t = {self.t:g} s")
         G = convection.conductance(name, re, pr, alpha, f.kappa, d)

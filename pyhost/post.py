@@ -29,6 +29,7 @@ import numpy as np
 
 from plugins.dem.hertz import DemHertz, hertz_collision_time
 from plugins.heat.batch import dem_pair, evaluate_flagged
+from plugins.heat import MODELS
 from plugins.heat.exchange import exchange_heat
 from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.contacts import find_contacts
@@ -39,7 +40,6 @@ from pyhost.scene import Material, SceneError, Wall, _build, read_toml
 from pyhost.walls import FACES
 
 MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
-MODELS = ("A", "B", "C")
 
 
 @dataclass(frozen=True)
@@ -140,7 +140,7 @@ ATOMS_REQUIRED = ("id", "type", "position", "velocity", "radius")
 class Post:
     """One post-processing job; ``run()`` writes the output folder and returns the summary."""
 
-    def __init__(self, dumps, scene: PostScene, out, contacts=(), script=None, computes=None, models=MODELS,
+    def __init__(self, dumps, scene: PostScene, out, contacts=(), script=None, computes=None, models=tuple(MODELS),
                  dt=None, skip_bad_frames=False):
         self.dumps, self.scene, self.out = list(dumps), scene, Path(out)
         self.contacts, self.script = list(contacts), script

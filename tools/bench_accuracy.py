@@ -27,7 +27,7 @@ import numpy as np
 from plugins.heat import Pair, exact, fast
 from plugins.heat import fit as F
 
-MODELS = ("A", "B", "C")
+MODELS = F.FITTED
 QUANT = ("e", "t_coll", "Q")
 RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)
 SPACING_FACTORS = (4.0, 2.0, 1.0, 0.5, 0.25)

@@ -40,7 +40,7 @@ sys.path.insert(0, str(ROOT))
 
 from foamlib import FoamFile  # noqa: E402
 
-from plugins.drag import get as drag_law  # noqa: E402
+from plugins.drag import LAWS  # noqa: E402
 from pyhost.engines.openfoam import run_utility  # noqa: E402
 from plugins.bed import ergun_pressure_drop  # noqa: E402
 
@@ -108,7 +108,7 @@ def settling_checks(w: Path, out: Path) -> list[Check]:
     """The sphere's last vertical speed (the tutorial's own velocity.txt) against the
     terminal speed of the Di Felice drag its couplingProperties name, at alpha = 1."""
     d, rho_p, rho, nu = 1e-4, 3000.0, 10.0, 1e-5
-    law = drag_law("difelice")
+    law = LAWS.lookup("difelice")
     vol = math.pi * d**3 / 6
     v_t = brentq(lambda v: float(law(1.0, v, d, rho, nu)) * v - (rho_p - rho) * vol * G, 1e-6, 10.0)
     row = last_row(w / "DEM" / "post" / "velocity.txt")
@@ -150,7 +150,7 @@ def layered_drop(fluid: Path, time: str, u: float, d: float, rho: float, nu: flo
         a = float(np.average(alpha[s], weights=volume[s]))
         share = 0.5 if k == 0 else 1.0
         if a < 1:
-            by_law += share * (1 - a) / vp * float(drag_law(law)(a, u / a, d, rho, nu)) * u / a**2 * dz
+            by_law += share * (1 - a) / vp * float(LAWS.lookup(law)(a, u / a, d, rho, nu)) * u / a**2 * dz
             ergun += share * ergun_pressure_drop(u, a, d, dz, rho, rho * nu)
         mean_p.append(float(np.average(p[s], weights=volume[s])))
     head = rho * 9.81 * (z.max() - z.min())

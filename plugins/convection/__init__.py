@@ -2,7 +2,7 @@
 the exchange of heat between particles and the gas of their cells over a coupling interval
 (``exchange``). Pure functions, SI units.
 
-- ``get(name)``: the Correlation registered as ``name`` (ValueError listing the choices);
+- ``CORRELATIONS``: the Nusselt correlations by name (``plugins.registry.Registry``);
 - ``conductance(name, re, pr, alpha, k_g, d)``: G = h A = Nu k_g / d * pi d^2 [W/K];
 - ``outside(name, re, pr, alpha)``: per quantity, the fraction of values outside the range
   where the correlation rests on data (an extrapolation there, not an error);
@@ -16,16 +16,8 @@ import numpy as np
 from plugins.convection.exchange import exchange
 from plugins.convection.nusselt import CORRELATIONS, Correlation
 
-__all__ = ["CORRELATIONS", "Correlation", "get", "heat_transfer_coefficient", "conductance", "outside", "exchange",
+__all__ = ["CORRELATIONS", "Correlation", "heat_transfer_coefficient", "conductance", "outside", "exchange",
            "particle_reynolds", "prandtl"]
-
-
-def get(name: str) -> Correlation:
-    try:
-        return CORRELATIONS[name]
-    except KeyError:
-        raise ValueError(f"unknown convection correlation {name!r}; choices: none, "
-                         f"{', '.join(sorted(CORRELATIONS))}") from None
 
 
 def heat_transfer_coefficient(nu, k_g, d):
@@ -36,7 +28,7 @@ def heat_transfer_coefficient(nu, k_g, d):
 
 def conductance(name: str, re, pr, alpha, k_g, d):
     """Gas-particle conductance G = h pi d^2 [W/K] of each particle by correlation ``name``."""
-    return heat_transfer_coefficient(get(name).nusselt(re, pr, alpha), k_g, d) * np.pi * np.asarray(d) ** 2
+    return heat_transfer_coefficient(CORRELATIONS.lookup(name).nusselt(re, pr, alpha), k_g, d) * np.pi * np.asarray(d) ** 2
 
 
 def outside(name: str, re, pr, alpha) -> dict:
@@ -44,7 +36,7 @@ def outside(name: str, re, pr, alpha) -> dict:
     "re", "pr", "alpha" that has any."""
     found = {}
     for key, values in (("re", re), ("pr", pr), ("alpha", alpha)):
-        lo, hi = get(name).validity[key]
+        lo, hi = CORRELATIONS.lookup(name).validity[key]
         v = np.atleast_1d(values)
         frac = float(np.mean((v < lo) | (v > hi))) if v.size else 0.0
         if frac > 0:

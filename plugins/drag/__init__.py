@@ -19,15 +19,7 @@ set II) and the host adds it separately.
 """
 from __future__ import annotations
 
-import importlib
-import pkgutil
+from plugins.registry import Registry
 
-from plugins.heat.registry import lookup
-
-LAWS = {info.name: importlib.import_module(f"{__name__}.{info.name}").MODEL
-        for info in pkgutil.iter_modules(__path__) if not info.name.startswith("_")}
-
-
-def get(name: str):
-    """The law registered as ``name``; ValueError listing the choices otherwise."""
-    return lookup(LAWS, name, "drag law")
+LAWS = Registry(__name__, __path__, "drag law")
+"""{name: law}; ``LAWS.lookup(name)`` for a message naming the choices."""

@@ -22,7 +22,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from plugins.heat.compression import K_HERTZ, FromTop, compression_law, hertz_time_from_top
-from plugins.heat.models import get_model
+from plugins.heat.models import MODELS
 from plugins.heat.pair import Pair
 from plugins.heat.recovery import RECOVERY_LAWS
 
@@ -49,7 +49,7 @@ def solve(model: str, v: float, b1: float, b2: float, c: float,
     """One collision in the units of ``compression.py``: v = v0/v_y; returns x_max, A_max
     (a_max^2/a_y^2), F_max, t_max, s_r (delta_r/delta_y), rho (R_bar/R*), v1, t_r, Q
     (in units of Pair.Q_scale), regime, and with ``history`` the arrays t, x, A, F."""
-    m = get_model(model)
+    m = MODELS.lookup(model)
     law = compression_law(m.compression, b1, b2, c)
     x_top = law.peak(v)
     A_max, F_max = float(law.a2(x_top)), float(law.force(x_top))

@@ -29,7 +29,7 @@ from scipy.interpolate import CubicSpline
 
 from plugins.heat import exact
 from plugins.heat.compression import compression_law
-from plugins.heat.models import get_model
+from plugins.heat.models import MODELS
 from plugins.heat.pair import Pair
 from plugins.heat.recovery import RECOVERY_LAWS
 
@@ -55,7 +55,7 @@ class Table:
         """``spacing``: node spacing in q (default H for A and C, H_SMOOTH for B); for
         studies of table resolution (tools/bench_accuracy.py)."""
         self.model, self.b1, self.b2, self.c = model, b1, b2, c
-        law = compression_law(get_model(model).compression, b1, b2, c)
+        law = compression_law(MODELS.lookup(model).compression, b1, b2, c)
         self.u_min, self.u_max = math.log(V_MIN), math.log(V_MAX)
         self.staged = hasattr(law, "v_hat_p")
         if self.staged:
@@ -195,7 +195,7 @@ def collide_fast(v0, pair: Pair | None = None, model: str = "A", outputs=exact.O
         raise ValueError(f"unknown outputs {sorted(unknown)}; choices: {', '.join(exact.OUTPUT_KEYS)}")
     if any(np.ndim(getattr(pair, k)) for k in ("b1", "b2")):
         raise ValueError("collide_fast: b1 and b2 must be scalars (group collisions by material pair)")
-    tab = table(get_model(model).name, float(pair.b1), float(pair.b2), float(pair.log_constant))
+    tab = table(MODELS.lookup(model).name, float(pair.b1), float(pair.b2), float(pair.log_constant))
     shape = np.broadcast_shapes(v0.shape, *(np.shape(getattr(pair, f)) for f in PAIR_FIELDS))
     n = math.prod(shape)
     flat = lambda a: np.asarray(a, float) if np.ndim(a) == 0 else np.broadcast_to(a, shape).ravel()
@@ -241,7 +241,7 @@ def _fill(out, s, tab, v0, sc):
             np.multiply(L[j], sc[scale], out=out[k][s])
     if not derived_keys:
         return
-    m = get_model(tab.model)
+    m = MODELS.lookup(tab.model)
     law = compression_law(m.compression, tab.b1, tab.b2, tab.c)
     x, e, t_y = L[0], L[3], sc["t_y"]
     A = law.a2(x)

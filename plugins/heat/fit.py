@@ -52,6 +52,7 @@ import math
 import numpy as np
 
 from plugins.heat.compression import K_HERTZ, _dG
+from plugins.heat.models import MODELS
 
 KAPPA_HERTZ = 0.8709254
 """Prefactor of eq. (31) for an exact Hertz impact (the printed 0.87), from the exact path."""
@@ -75,6 +76,18 @@ ERROR_BOUND = {
     ("A", "Q"): 0.025, ("B", "Q"): 1e-6, ("C", "Q"): 0.025,
 }
 """Maximum relative error over the physical range of the validity domain."""
+
+FITTED = tuple(sorted({model for model, _ in ERROR_BOUND}))
+"""The contact models the relations are fitted for."""
+
+
+def _laws(model) -> tuple[bool, bool]:
+    """(compression fully plastic from the start (Johnson's), recovery by geometric similarity
+    (Stronge's)) of a fitted model, from its registry entry (plugins.heat.models)."""
+    if model not in FITTED:
+        raise ValueError(f"no fitted relations for contact model {model!r}; fitted: {', '.join(FITTED)}")
+    m = MODELS.lookup(model)
+    return m.compression == "Johnson", m.recovery == "Stronge"
 
 QUANTITIES = ("e", "t_coll", "Q")
 
@@ -105,7 +118,7 @@ def contact_area(model, v_hat, b1, b2, c=None, iterations=3):
     v = np.asarray(v_hat, float)
     b1, b2 = np.asarray(b1, float), np.asarray(b2, float)
     beta = b2 / b1
-    if model == "B":
+    if _laws(model)[0]:
         return np.sqrt(1.6 / beta) * v
     c = 3.0 * b1 if c is None else c
     X_p, W_p, v_hat_p = plastic_onset(b1, b2, c)
@@ -127,8 +140,9 @@ def skeleton(model, v_hat, b1, b2, c=None, kappa=None):
     c = 3.0 * b1 if c is None else c
     X = contact_area(model, v, b1, b2, c)
     # mean pressure at the turning point in units of b1 Y: eqs. (8), (11)
-    p = beta if model == "B" else np.minimum(1.0 + np.log(np.maximum(X, 1.0)) / c, beta)
-    e = (1.0 if model == "A" else p) * X**0.75 / v                    # eqs. (22), (28)
+    plastic, similar = _laws(model)
+    p = beta if plastic else np.minimum(1.0 + np.log(np.maximum(X, 1.0)) / c, beta)
+    e = (1.0 if similar else p) * X**0.75 / v                         # eqs. (22), (28)
     t_max = 0.5 * math.pi / np.sqrt(2.5 * p)                          # eq. (15) with p
     t_r = K_HERTZ * X**-0.25                                          # eqs. (23), (29)
     t_coll = t_max + t_r
@@ -158,12 +172,10 @@ def dimensionless(model, v_hat, b1, b2, c=None, constants=None):
     """e [-], t_coll [t_y] and Q [Q_scale] by the fitted relations, for v_hat = v0/v_y.
     ``constants`` overrides CONSTANTS (used while fitting)."""
     k = CONSTANTS if constants is None else constants
-    if model not in ("A", "B", "C"):
-        raise ValueError(f"unknown contact model {model!r}; choices: A, B, C")
     v = np.asarray(v_hat, float)
     sk = skeleton(model, v, b1, b2, c, k["kappa"])
     out = {q: sk[q] for q in QUANTITIES}
-    if model != "B":
+    if not _laws(model)[0]:                 # Johnson's compression is closed-form (exact)
         beta, _, zeta = groups(v, b1, b2, c)
         for q in QUANTITIES:
             p = k[(model if q == "e" else "A", q)]

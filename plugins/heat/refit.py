@@ -17,7 +17,7 @@ import numpy as np
 
 from plugins.heat import fit as F
 
-MODELS = ("A", "B", "C")
+MODELS = F.FITTED
 
 
 def random_pairs(n, rng):

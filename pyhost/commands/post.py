@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from plugins.heat import MODELS
+
 HELP = "collision heat of a finished LIGGGHTS run from its dump files (models A, B, C)"
 
 
@@ -20,7 +22,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                                                "mesh wall fixes)")
     p.add_argument("--compute", action="append", default=[], metavar="'ID STYLE KEYWORDS'",
                    help="a contact compute's keywords when there is no script, e.g. 'cp pair/gran/local pos vel id'")
-    p.add_argument("--model", choices=("A", "B", "C", "all"), default="all", help="contact heat model")
+    p.add_argument("--model", choices=(*MODELS, "all"), default="all", help="contact heat model")
     p.add_argument("--out", type=Path, default=Path("collheat-post"), help="output folder")
     p.add_argument("--dt", type=float, help="DEM time step [s] (default: the script's timestep)")
     p.add_argument("--skip-bad-frames", action="store_true", help="warn about a bad frame, skip it and go on")
@@ -28,7 +30,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     from pyhost.dumps import parse_compute, read_script
-    from pyhost.post import MODELS, Post, load_post_scene
+    from pyhost.post import Post, load_post_scene
 
     scene = load_post_scene(args.scene)
     script = read_script(args.script) if args.script else None
@@ -36,7 +38,7 @@ def run(args) -> int:
     if args.dt is not None and not args.dt > 0:
         raise ValueError(f"--dt: must be > 0, got {args.dt}")
     post = Post(args.dumps, scene, args.out, contacts=args.contacts, script=script, computes=computes,
-                models=MODELS if args.model == "all" else (args.model,), dt=args.dt,
+                models=tuple(MODELS) if args.model == "all" else (args.model,), dt=args.dt,
                 skip_bad_frames=args.skip_bad_frames)
     summary = post.run()
     for w in summary["warnings"]:

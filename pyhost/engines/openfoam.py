@@ -135,7 +135,7 @@ class FluidSolver:
             raise FluidError(f"{self.case} is not an OpenFOAM case (no system/controlDict)")
         if nprocs < 1:
             raise ValueError(f"nprocs must be >= 1, got {nprocs}")
-        self.drag_law = drag_laws.get(drag)
+        self.drag_law = drag_laws.LAWS.lookup(drag)
         self.drag = drag
         self.nprocs, self.alpha_min, self.timeout = nprocs, alpha_min, timeout
         if void_fraction not in ("centre", "divided"):

@@ -13,7 +13,7 @@ import pytest
 from foamlib import FoamFile
 from scipy.optimize import brentq
 
-from plugins.drag import get as drag_law
+from plugins.drag import LAWS
 from pyhost.engines.fluid_case import box_case
 
 pytestmark = pytest.mark.engines
@@ -108,7 +108,7 @@ def velocities(cfd: Path) -> np.ndarray:
 
 
 def terminal_speed() -> float:
-    law = drag_law("difelice")
+    law = LAWS.lookup("difelice")
     weight = (RHO_P - RHO) * math.pi * D**3 / 6 * 9.81
     return brentq(lambda v: float(law(1.0, v, D, RHO, NU)) * v - weight, 1e-6, 10.0)
 

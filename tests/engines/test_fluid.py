@@ -77,7 +77,7 @@ def test_sphere_settles_at_the_terminal_velocity_of_the_drag_law(tmp_path, law):
     d, rho_p = 1e-3, 2500.0
     vp = np.pi * d**3 / 6
     weight = (rho_p - WATER["rho"]) * vp * G           # N, gravity less buoyancy
-    law_k = drag.get(law)
+    law_k = drag.LAWS.lookup(law)
     v_terminal = brentq(lambda s: law_k(alpha, s, d, **WATER) * s - weight, 1e-6, 10.0)
     v_end = np.mean(vz[-20:])
     print(f"{law}: terminal {v_end:.5f} m/s, law {v_terminal:.5f} m/s, "

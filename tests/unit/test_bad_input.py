@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from plugins.heat import Pair, collide, get_model
+from plugins.heat import MODELS, Pair, collide
 from plugins.heat.fast import collide_fast
 
 
@@ -36,7 +36,7 @@ def test_bad_speed(v0):
 
 def test_unknown_model_lists_choices():
     with pytest.raises(ValueError, match="A, B, C"):
-        get_model("D")
+        MODELS.lookup("D")
 
 
 def run_cli(*args):

@@ -9,7 +9,7 @@ from scipy.integrate import quad, solve_ivp
 from scipy.special import betainc
 
 from plugins.heat import MODEL_NAMES, Pair, collide
-from plugins.heat.comparison import COMPARISON, DemPair, get_comparison
+from plugins.heat.comparison import COMPARISON, DemPair
 from plugins.heat.batch import dem_pair, evaluate, pair_properties, side_heat
 from pyhost.schema import DemContact, Material
 
@@ -121,7 +121,7 @@ def test_evaluate_takes_comparison_models_and_rejects_unknown_names():
     Q, e, t = evaluate("softened", "fast", mats, mi, mj, R_i, R_j, v0, dT)
     for k in range(2):
         pair = Pair(R1=R_i[k], R2=R_j[k], dT=dT[k], **pair_properties(mats[mi[k]], mats[mj[k]]))
-        ref = get_comparison("softened").heat(v0[k], pair, dem_pair(mats[mi[k]], mats[mj[k]]))
+        ref = COMPARISON.lookup("softened").heat(v0[k], pair, dem_pair(mats[mi[k]], mats[mj[k]]))
         assert (Q[k], t[k]) == pytest.approx((float(ref["Q"]), float(ref["t_coll"])), rel=1e-12)
     assert np.all(np.isnan(e))
     with pytest.raises(ValueError) as err:

@@ -3,7 +3,7 @@ coupling interval (conservation, no overshoot at any interval, exact limits)."""
 import numpy as np
 import pytest
 
-from plugins.convection import CORRELATIONS, conductance, exchange, get, outside
+from plugins.convection import CORRELATIONS, conductance, exchange, outside
 
 AIR_PR = 0.71
 RE = np.logspace(-3, 4.5, 300)
@@ -11,8 +11,8 @@ RE = np.logspace(-3, 4.5, 300)
 
 def test_registry_holds_the_three_and_refuses_others_with_the_list():
     assert {"ranz_marshall", "gunn", "li_mason"} <= set(CORRELATIONS)
-    with pytest.raises(ValueError, match="choices: none, gunn, li_mason, ranz_marshall"):
-        get("wakao")
+    with pytest.raises(ValueError, match="unknown convection correlation .wakao.; choices: gunn, li_mason, ranz_marshall"):
+        CORRELATIONS.lookup("wakao")
 
 
 @pytest.mark.parametrize("name", sorted(CORRELATIONS))
@@ -20,20 +20,20 @@ def test_single_sphere_in_still_gas_conducts_like_a_sphere_in_an_infinite_medium
     """Re -> 0, alpha = 1: Nu -> 2, i.e. G = 2 pi k d, the steady conduction from a sphere
     into an unbounded medium (4 pi k r), to 1e-5 at Re = 1e-30 (Gunn's Re^0.2 term is slow)."""
     k, d = 0.026, 1e-3
-    assert get(name).nusselt(1e-30, AIR_PR, 1.0) == pytest.approx(2.0, rel=1e-5)
+    assert CORRELATIONS.lookup(name).nusselt(1e-30, AIR_PR, 1.0) == pytest.approx(2.0, rel=1e-5)
     assert conductance(name, 1e-30, AIR_PR, 1.0, k, d) == pytest.approx(2 * np.pi * k * d, rel=1e-5)
 
 
 @pytest.mark.parametrize("name", sorted(CORRELATIONS))
 def test_nusselt_grows_with_reynolds_number(name):
     for alpha in (0.4, 0.7, 1.0):
-        nu = get(name).nusselt(RE, AIR_PR, alpha)
+        nu = CORRELATIONS.lookup(name).nusselt(RE, AIR_PR, alpha)
         assert np.all(np.isfinite(nu)) and np.all(np.diff(nu) > 0)
 
 
 def test_ranz_marshall_is_two_plus_the_square_root_law():
     """Nu - 2 scales as Re^(1/2) Pr^(1/3): quadrupling Re doubles it, eightfold Pr doubles it."""
-    f = get("ranz_marshall").nusselt
+    f = CORRELATIONS.lookup("ranz_marshall").nusselt
     assert (f(400.0, 0.7, 1) - 2) / (f(100.0, 0.7, 1) - 2) == pytest.approx(2.0, rel=1e-12)
     assert (f(100.0, 5.6, 1) - 2) / (f(100.0, 0.7, 1) - 2) == pytest.approx(2.0, rel=1e-12)
 
@@ -44,7 +44,7 @@ def test_gunn_limits():
     Wakao & Kaguei's packed-bed Nu = 2 + 1.1 Re^0.6 Pr^(1/3) (Heat and mass transfer in
     packed beds, 1982), fitted independently to partly the same data, for 100 <= Re <= 3000
     (below, Gunn keeps the bed's conduction floor 3.8 where Wakao-Kaguei tends to 2)."""
-    f = get("gunn").nusselt
+    f = CORRELATIONS.lookup("gunn").nusselt
     assert f(1e-30, AIR_PR, 1.0) == pytest.approx(2.0, rel=1e-5)
     assert f(1e-30, AIR_PR, 0.4) == pytest.approx(3.8, rel=1e-5)
     re = np.logspace(2, np.log10(3000), 20)
@@ -55,9 +55,9 @@ def test_gunn_limits():
 def test_li_mason_reduces_to_ranz_marshall_and_its_branches_meet():
     """Li & Mason (2000): at alpha = 1 and Re < 200 it is Ranz-Marshall; its branches meet
     within 0.4 % at Re = 200 (any Pr) and within 0.5 % at Re = 1500 for a gas (Pr = 0.71)."""
-    f = get("li_mason").nusselt
+    f = CORRELATIONS.lookup("li_mason").nusselt
     re = np.linspace(0.1, 199, 50)
-    assert np.allclose(f(re, 2.0, 1.0), get("ranz_marshall").nusselt(re, 2.0, 1.0), rtol=1e-14)
+    assert np.allclose(f(re, 2.0, 1.0), CORRELATIONS.lookup("ranz_marshall").nusselt(re, 2.0, 1.0), rtol=1e-14)
     for alpha in (0.5, 1.0):
         for pr in (0.71, 5.0):
             assert f(200 * (1 + 1e-12), pr, alpha) == pytest.approx(f(200 * (1 - 1e-12), pr, alpha), rel=4e-3)

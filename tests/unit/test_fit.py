@@ -71,7 +71,7 @@ def test_classical_forms_meet_one_at_yield_and_fall_as_quarter_power():
 
 
 def test_fit_rejects_unknown_model_and_array_b():
-    with pytest.raises(ValueError, match="choices"):
+    with pytest.raises(ValueError, match="no fitted relations for contact model .D.; fitted: A, B, C"):
         collide_fit(np.array([1.0]), Pair(), "D")
     with pytest.raises(ValueError, match="scalars"):
         collide_fit(np.array([1.0]), Pair(b1=np.array([1.1, 1.2]), b2=3.0), "A")

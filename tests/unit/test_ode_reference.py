@@ -12,12 +12,12 @@ from scipy.optimize import brentq
 
 from plugins.heat import collide
 from plugins.heat.compression import compression_law
-from plugins.heat.models import get_model
+from plugins.heat.models import MODELS
 from plugins.heat.recovery import RECOVERY_LAWS
 
 
 def integrate(pair, model, v0):
-    m = get_model(model)
+    m = MODELS.lookup(model)
     law = compression_law(m.compression, pair.b1, pair.b2, float(pair.log_constant))
     dy, Fy, ay = pair.delta_y, pair.F_y, pair.a_y
     tol = dict(method="DOP853", rtol=1e-13, atol=1e-30, dense_output=True)

@@ -7,7 +7,6 @@ from scipy.integrate import quad
 
 from plugins.heat import MODELS, Pair, collide
 from plugins.heat.compression import compression_law
-from plugins.heat.models import get_model
 
 FLOATS = ("t_max", "delta_max", "a_max", "F_max", "delta_r", "delta_f", "R_bar", "t_r", "v1",
           "e", "t_coll", "Q", "Q_closed_form")
@@ -16,7 +15,7 @@ SPEEDS = (1e-4, 0.003, 0.02, 0.4, 1.5, 30.0)
 
 def contact_force(pair, model, delta):
     """Compression force [N] at indentation delta [m], straight from eqs. (4), (8), (11), (12)."""
-    law = compression_law(get_model(model).compression, pair.b1, pair.b2, float(pair.log_constant))
+    law = compression_law(MODELS.lookup(model).compression, pair.b1, pair.b2, float(pair.log_constant))
     return float(law.force(delta / pair.delta_y)) * pair.F_y
 
 

@@ -1,11 +1,11 @@
 """Nusselt correlations registered by name: one module per correlation, file name = registry
-key = the value of ``[effects] convection``. Each module defines ``CORRELATION``."""
+key = the value of ``[effects] convection``. Each module defines ``MODEL``, a ``Correlation``."""
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from dataclasses import dataclass
 from typing import Callable
+
+from plugins.registry import Registry
 
 
 @dataclass(frozen=True)
@@ -22,7 +22,5 @@ class Correlation:
     source: str
 
 
-CORRELATIONS: dict[str, Correlation] = {
-    info.name: importlib.import_module(f"{__name__}.{info.name}").CORRELATION
-    for info in pkgutil.iter_modules(__path__)
-}
+CORRELATIONS = Registry(__name__, __path__, "convection correlation")
+"""{name: Correlation}; ``CORRELATIONS.lookup(name)`` for a message naming the choices."""

@@ -18,5 +18,5 @@ def nusselt(re, pr, alpha):
             + (1.33 - 2.4 * a + 1.2 * a**2) * np.power(re, 0.7) * p3)
 
 
-CORRELATION = Correlation("gunn", nusselt, dict(re=(0.0, 1e5), pr=(0.6, 1e3), alpha=(0.35, 1.0)),
+MODEL = Correlation("gunn", nusselt, dict(re=(0.0, 1e5), pr=(0.6, 1e3), alpha=(0.35, 1.0)),
                           "Gunn, Int. J. Heat Mass Transfer 21 (1978) 467-476, eq. 29")

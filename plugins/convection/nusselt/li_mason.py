@@ -25,5 +25,5 @@ def nusselt(re, pr, alpha):
                                         4.5e-5 * np.power(re, 1.8)))
 
 
-CORRELATION = Correlation("li_mason", nusselt, dict(re=(0.0, 1e5), pr=(0.6, 1.0), alpha=(0.35, 1.0)),
+MODEL = Correlation("li_mason", nusselt, dict(re=(0.0, 1e5), pr=(0.6, 1.0), alpha=(0.35, 1.0)),
                           "Li & Mason, Powder Technol. 112 (2000) 273-282, eq. 14")

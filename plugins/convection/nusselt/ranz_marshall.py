@@ -16,5 +16,5 @@ def nusselt(re, pr, alpha):
     return 2.0 + 0.6 * np.sqrt(re) * np.cbrt(pr) + 0.0 * np.asarray(alpha)
 
 
-CORRELATION = Correlation("ranz_marshall", nusselt, dict(re=(0.0, 200.0), pr=(0.6, 250.0), alpha=(0.0, 1.0)),
+MODEL = Correlation("ranz_marshall", nusselt, dict(re=(0.0, 200.0), pr=(0.6, 250.0), alpha=(0.0, 1.0)),
                           "Ranz & Marshall, Chem. Eng. Prog. 48 (1952) 141-146, eq. 11")

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
-from plugins.heat.registry import collect, lookup
+from plugins.registry import Registry
 
 
 @dataclass(frozen=True)
@@ -42,9 +42,5 @@ class ComparisonModel:
     heat: Callable          # heat(v0, pair, dem) -> dict(Q=..., t_coll=..., e=...)
 
 
-COMPARISON: dict[str, ComparisonModel] = collect(__name__, __path__)
-
-
-def get_comparison(name: str) -> ComparisonModel:
-    """The comparison model ``name``; an unknown name raises ValueError with the choices."""
-    return lookup(COMPARISON, name, "comparison model")
+COMPARISON = Registry(__name__, __path__, "comparison model")
+"""{name: ComparisonModel}; ``COMPARISON.lookup(name)`` for a message naming the choices."""

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from plugins.heat.registry import collect, lookup
+from plugins.registry import Registry
 
 
 @dataclass(frozen=True)
@@ -20,9 +20,5 @@ class Model:
     description: str
 
 
-MODELS: dict[str, Model] = collect(__name__, __path__)
-
-
-def get_model(name: str) -> Model:
-    """The model registered as ``name``; an unknown name raises ValueError with the choices."""
-    return lookup(MODELS, name, "contact model")
+MODELS = Registry(__name__, __path__, "contact model")
+"""{name: Model}; ``MODELS.lookup(name)`` for a message naming the choices."""
