@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import pyvista
 
-from pyhost.loop import COLLISION_COLUMNS
+from pyhost.effects.collisions import COLLISION_COLUMNS
 from pyhost.output import (ColumnLog, CsvLog, Progress, VtkSeries, collision_kinds, collisions_to_csv,
                            read_collisions, read_columns)
 

@@ -1,0 +1,456 @@
+"""Collision heat, restitution and the collision log: every contact that begins is a collision,
+its impact speed recorded at first touch inside LIGGGHTS (contact events, pyhost.engines.events)
+or recovered from samples of the contact lists (``time.contacts = "samples"``), its heat from
+the plugin moved at once, the model's restitution imposed at its end if asked, a script's
+fix heat/gran undone during the collision's model time. Present when the scene needs contacts
+(``contact_extraction``: collision heat or restitution feedback). SI units.
+
+How a sampled contact is classified (collision, then enduring) is told in ``pyhost.collisions``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from plugins.dem.hertz import DemHertz, effective_modulus
+from plugins.dem.impulse import restitution_impulse
+from plugins.heat.batch import evaluate_flagged, side_heat
+from plugins.heat.exchange import exchange_heat, temperature_difference
+from pyhost.collisions import WALL_BASE, ContactTracker, contact_keys
+from pyhost.effects import Effect
+from pyhost.engines.events import BEGIN, END
+from pyhost.output import ColumnLog, CsvLog, collision_kinds
+
+COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
+OPEN_COLUMNS = ("start", "t_coll", "e", "v0", "nx", "ny", "nz")
+"""What the host keeps of each open contact: start time [s], model duration [s], the model's
+restitution (NaN: none to impose), impact speed [m/s] and unit normal at the start."""
+
+
+class CollisionHeat(Effect):
+    """``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
+    ``logs``: the checkpoint's output marks to continue from (None: a new run)."""
+
+    def __init__(self, loop, walls, logs: dict | None = None):
+        super().__init__(loop)
+        scene, dem = loop.scene, loop.dem
+        self.tracker = ContactTracker()
+        self.info = np.empty((0, len(OPEN_COLUMNS)))   # per open contact, rows aligned with tracker.open_keys
+        self.laws = {}
+        self.events = dem.events is not None     # contacts recorded inside LIGGGHTS (else sampled)
+        self.t_coll_of = {}                      # (key, begin step) -> t_coll [s] of pair collisions under heat/gran
+        self.restitution = self.events and scene.effects.restitution_feedback and loop.heat
+        self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
+        columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
+        mark = (logs or {}).get("collisions")
+        self.log = (ColumnLog(loop.out / "collisions", collision_kinds(columns), mark)
+                    if scene.output.collisions == "binary" else CsvLog(loop.out / "collisions.csv", columns, mark))
+        self.update_walls(walls)
+        self.sampled = not self.events or dem.sampled_walls()   # (after the recorder took the walls it can)
+
+    @property
+    def dem(self):
+        return self.loop.dem
+
+    @property
+    def scene(self):
+        return self.loop.scene
+
+    @property
+    def totals(self) -> dict:
+        return self.loop.totals
+
+    @property
+    def warned(self) -> set:
+        return self.loop.warned
+
+    def update_walls(self, walls) -> None:
+        """The LIGGGHTS walls as the host sees them (a script may add walls between runs)."""
+        self.walls = walls
+        self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
+        self.T_wall = np.array([w.temperature if self.loop.effects["wall_heat"] else np.nan for w in walls])
+        self.wall_material = np.array([w.material for w in walls], int)
+        if self.dem.events is not None:
+            self.dem.event_planes(self.wall_index)
+
+    def start(self) -> None:
+        if self.loop.every["sample"]:
+            self.open_present()
+
+    def after_chunk(self, due: dict):
+        """The contacts' work at the end of a DEM chunk: the events harvested, the contact
+        lists sampled, as due. Returns the atoms it gathered (None if it gathered none)."""
+        loop = self.loop
+        if self.events and self.harvest_alone(due):
+            self.harvest_partly()
+            return None
+        if not (due["sample"] or (self.events and any(due.values()))):
+            return None
+        atoms = self.dem.atoms(loop.heat)
+        loop.track_particles(atoms)
+        if self.events:
+            self.harvest(atoms, final=bool(due["checkpoint"]))
+        if due["sample"]:
+            self.sample_contacts(atoms)
+        return atoms
+
+    def end_of_run(self, atoms) -> None:
+        """At the end of each of the script's runs: the events so far."""
+        if self.events:
+            self.harvest(atoms)
+
+    def state(self) -> tuple[dict, dict]:
+        return (dict(logs=dict(collisions=self.log.mark())),
+                dict(open_keys=self.tracker.open_keys, contact_info=self.info,
+                     target_keys=np.array(list(self.targets), np.int64),
+                     target_speed=np.array([v[0] for v in self.targets.values()]),
+                     target_normal=np.array([v[1] for v in self.targets.values()]).reshape(-1, 3)))
+
+    def restore(self, state: dict) -> None:
+        self.tracker.update(state["open_keys"])
+        self.info = np.asarray(state["contact_info"], float).reshape(-1, len(OPEN_COLUMNS))
+        if self.restitution and len(state.get("target_keys", ())):   # separation speeds of contacts still open
+            self.dem.events.restitution(state["target_keys"], state["target_speed"], state["target_normal"])
+            self.targets = dict(zip(state["target_keys"].tolist(),
+                                    zip(state["target_speed"].tolist(), state["target_normal"].tolist())))
+
+    def close(self) -> None:
+        self.log.close()
+
+    def open_present(self) -> None:
+        """The contacts present now count as open, enduring (t_coll 0: no collision time to
+        account for), with no restitution to impose at their end (e NaN)."""
+        c = self.dem.contacts(self.dem.atoms(self.loop.heat), self.wall_index)
+        keys = contact_keys(c.i, c.j)
+        self.tracker.update(keys)
+        n = len(keys)
+        self.info = np.column_stack([np.full(n, self.loop.t), np.zeros(n), np.full(n, math.nan), np.full(n, math.nan),
+                                     np.asarray(c.normal, float).reshape(n, 3)])
+
+    def sample_contacts(self, atoms) -> None:
+        c = self.dem.contacts(atoms, self.wall_index)
+        keys = contact_keys(c.i, c.j)
+        last_keys, last = self.tracker.open_keys, self.info
+        opened, closed, prev = self.tracker.match(keys)
+        self.info = np.empty((len(keys), len(OPEN_COLUMNS)))
+        kept = prev >= 0
+        self.info[kept] = last[prev[kept]]
+        if len(opened):
+            self.start_collisions(atoms, c, keys, opened)
+        if len(closed):
+            self.end_collisions(atoms, last_keys[closed], last[closed])
+        if self.loop.heat and self.dem.info.heat_gran and len(c):
+            self.undo_heat_gran(atoms, c)
+
+    def dem_law(self, a: int, b: int) -> DemHertz:
+        """The DEM's Hertz law between atom types a and b, from the script's own values
+        (LIGGGHTS' effective modulus and per-pair restitution); read once per pair."""
+        if (a, b) not in self.laws:
+            E = self.dem.type_values("youngsModulus", (a, b))
+            nu = self.dem.type_values("poissonsRatio", (a, b))
+            e = self.dem.type_pair_value("coefficientRestitution", a, b)
+            self.laws[a, b] = DemHertz(effective_modulus(E[0], nu[0], E[1], nu[1]), e)
+        return self.laws[a, b]
+
+    def flag_outside_range(self, flagged, v0) -> None:
+        """Collisions the contact models do not cover (plugins.heat.validity, as ``collide`` flags
+        them): counted in summary.json (outside_model_range), said once; their heat is moved."""
+        self.totals["outside_model_range"] += int(flagged.sum())
+        if "outside_model_range" not in self.warned:
+            self.warned.add("outside_model_range")
+            print(f"warning: a collision at v0 = {float(np.max(v0[flagged])):.4g} m/s is outside the contact models' "
+                  "range (indentation beyond the smaller radius, or an output overflows): its heat is the models' "
+                  "extrapolation; such collisions are counted in summary.json as outside_model_range")
+
+    def partners(self, atoms, i, j):
+        """For contacts between local atoms i and partners j (atom ids, or WALL_BASE + wall):
+        whether j is a wall, j as a local index or wall code, its material, atom type (walls:
+        their LIGGGHTS type), radius [m] and mass [kg] (inf for walls)."""
+        wall = j >= WALL_BASE
+        jl = np.where(wall, j, atoms.index(np.where(wall, 0, j)))
+        w = np.where(wall, j - WALL_BASE, 0)
+        jj = np.where(wall, 0, jl)
+        mat_i = self.loop.materials_of(atoms.type[i])
+        wall_mat = np.where(self.wall_material[w] >= 0, self.wall_material[w], mat_i) if len(self.walls) else mat_i
+        mat = np.where(wall, wall_mat, self.loop.materials_of(atoms.type[jj]))
+        wall_type = np.array([self.dem.info.wall_type(wl.fix, wl.mesh) or 1 for wl in self.walls] or [1])
+        typ = np.where(wall, wall_type[w], atoms.type[jj])
+        return (wall, jl, mat, typ, np.where(wall, np.inf, atoms.radius[jj]),
+                np.where(wall, np.inf, atoms.mass[jj]))
+
+    def harvest_alone(self, due) -> bool:
+        """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran:
+        then only the colliding atoms are gathered to rank 0 (``harvest_partly``). Nothing but
+        the host changes a temperature then, and each atom's heat content in the balance is
+        brought up to date when it is next seen."""
+        return (self.dem.link is not None and not self.dem.events.window and self.loop.keep_all is None
+                and due["harvest"] and not any(v for k, v in due.items() if k != "harvest"))
+
+    def harvest_partly(self) -> None:
+        """A harvest under MPI for which rank 0 gathers only the atoms of the events (the
+        others stay on their ranks): ``harvest`` on them."""
+        ev = self.dem.events.take()
+        if not len(ev):
+            return
+        ids = np.unique(np.r_[ev["i"], ev["j"][~ev["wall"]]])
+        atoms = self.dem.atoms_of(ids, self.loop.heat)
+        self.loop.track_particles(atoms, departures=False)
+        self.harvest(atoms, ev=ev)
+
+    def harvest(self, atoms, final: bool = False, ev=None) -> None:
+        """The contact events recorded inside LIGGGHTS since the last harvest: each begun
+        contact is a collision, at its impact speed as recorded at first touch, its heat moved
+        now in the order the collisions happened. Without a fix heat/gran nothing else changes
+        a temperature between two harvests (they come at every fluid exchange, frame and
+        sample), so the heat is what it would be if moved at each collision's own step; with
+        one, each collision takes the temperature difference it began with (the recorder notes
+        the two temperatures at its first step), and what heat/gran conducted through each new
+        contact during the collision's model time is taken back (``take_back_heat_gran``;
+        ``final``: also for contacts younger than its window, at a checkpoint or the end). A
+        collision whose particle left the simulation before the harvest (deleted, out of the
+        box) is counted apart (collisions_of_departed) and moves no heat: its heat content left
+        at its last sample; so is one that began with no approach speed
+        (contacts_without_impact)."""
+        ev = self.dem.events.take() if ev is None else ev
+        begin, ends = ev[ev["kind"] == BEGIN], ev[ev["kind"] == END]
+        if self.dem.events.joined:               # open contacts that moved between ranks (MPI)
+            self.totals["contacts_changed_rank"] = self.totals.get("contacts_changed_rank", 0) + len(self.dem.events.joined)
+        if self.targets and len(ends):
+            self.ended_with_targets(atoms, ends)
+        if len(begin):
+            self.collide_begun(atoms, begin, ends)
+        if self.dem.events.window:
+            dt = self.dem.dt
+            for key, began, moved in self.dem.events.joined:   # a flux history goes on on another rank
+                if (key, began) in self.t_coll_of:
+                    self.t_coll_of[key, moved] = self.t_coll_of[key, began] - (moved - began) * dt
+            self.take_back_heat_gran(atoms, final)
+
+    def ended_with_targets(self, atoms, ends) -> None:
+        """Contacts given a separation speed that ended since the last harvest: the recorder
+        imposed it at the end, unless the pair's atoms were on two ranks (MPI: the recorder
+        changes only its own rank's atoms) or one was gone. Those get it now, from the
+        velocities now (restitution_late), as a contact shorter than the harvest interval does.
+        Under MPI every rank forgets these contacts' speeds (each keeps all, as a contact may
+        move between ranks)."""
+        keys = contact_keys(ends["i"], ends["j"])
+        late = []
+        for r, (key, imposed) in enumerate(zip(keys.tolist(), ends["imposed"].tolist())):
+            target = self.targets.pop(key, None)
+            if target is not None and not imposed:
+                late.append((r,) + target)
+        if self.dem.link is not None:
+            self.dem.events.forget(keys)
+        if late:
+            rows = np.array([r for r, _, _ in late])
+            present = (atoms.index(ends["i"][rows]) >= 0) & (ends["wall"][rows] | (atoms.index(ends["j"][rows]) >= 0))
+            self.totals["restitution_not_imposed"] = self.totals.get("restitution_not_imposed", 0) + int((~present).sum())
+            self.totals["restitution_late"] = self.totals.get("restitution_late", 0) + int(present.sum())
+            self.impose_separation(atoms, ends["i"][rows], ends["j"][rows], np.array([n for _, _, n in late]),
+                                   np.ones(len(rows)), np.array([v for _, v, _ in late]))
+
+    def collide_begun(self, atoms, begin, ends) -> None:
+        i = atoms.index(begin["i"])
+        j_here = np.where(begin["wall"], 0, atoms.index(np.where(begin["wall"], begin["i"], begin["j"])))
+        here = (i >= 0) & (j_here >= 0)
+        if not here.all():
+            self.totals["collisions_of_departed"] = self.totals.get("collisions_of_departed", 0) + int((~here).sum())
+        # a contact that begins without closing in (particles grown into each other by a fix
+        # adapt, or placed touching) is no impact: open, with no collision heat
+        still = here & ~(begin["vn"] > 0)
+        if still.any():
+            self.totals["contacts_without_impact"] = self.totals.get("contacts_without_impact", 0) + int(still.sum())
+        begin = begin[here & ~still]
+        # in the order of step, then ids: not of the recorder's lists, which follow the atoms'
+        # order in memory (a restart or another number of ranks changes it)
+        begin = begin[np.lexsort((begin["j"], begin["i"], begin["wall"], begin["step"]))]
+        if len(begin):
+            at = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["n"], begin["step"] * self.dem.dt,
+                              T_begin=begin["T"])
+            if self.dem.events.window:          # each pair collision's model time, until its flux history comes
+                pair = ~begin["wall"]
+                keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
+                self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), at[pair, 1].tolist()))
+            if self.restitution:
+                self.ask_restitution(atoms, begin, at, ends)
+
+    def ask_restitution(self, atoms, begin, at, ends) -> None:
+        """Restitution feedback on contact events: each collision's separation speed e v0 (e
+        above 1 clipped, counted) handed to the recorder, which imposes it at the step the
+        contact ends. A contact that ended before this harvest (shorter than the harvest
+        interval, time.sample_every steps) gets it now, from the velocities now, as the samples
+        did (counted as restitution_late)."""
+        e, v0 = at[:, 2], at[:, 3]
+        self.totals["clipped"] += int(np.sum(e > 1.0))
+        speed = np.minimum(e, 1.0) * v0
+        keys = contact_keys(begin["i"], begin["j"])
+        ended = {}
+        for key, step in zip(contact_keys(ends["i"], ends["j"]).tolist(), ends["step"].tolist()):
+            ended.setdefault(key, []).append(step)
+        late = np.array([any(s > b for s in ended.get(k, ())) for k, b in zip(keys.tolist(), begin["step"].tolist())],
+                        bool)
+        ask = ~late & ~np.isnan(speed)
+        if ask.any():
+            self.dem.events.restitution(keys[ask], speed[ask], begin["n"][ask])
+            self.targets.update(zip(keys[ask].tolist(), zip(speed[ask].tolist(), begin["n"][ask].tolist())))
+        if late.any():
+            self.totals["restitution_late"] = self.totals.get("restitution_late", 0) + int(late.sum())
+            self.impose_separation(atoms, begin["i"][late], begin["j"][late], begin["n"][late],
+                                   np.minimum(e[late], 1.0), v0[late])
+
+    def take_back_heat_gran(self, atoms, final: bool) -> None:
+        """What the script's fix heat/gran conducted through each new pair contact during the
+        collision's model duration t_coll, taken back (the collision heat stands for that time):
+        from the recorder's flux history of the contact, step m from the begin carrying flux f_m
+        [W] over dt, Q = dt sum_m f_m clip(t_coll / dt - m, 0, 1) [J] into the smaller id. Exact
+        per step, where the samples took the flux at each sample over the sample interval."""
+        i, j, start, filled, flux = self.dem.events.histories(all=final)
+        if not len(i):
+            return
+        keys = contact_keys(i, j).tolist()
+        t_coll = np.array([self.t_coll_of.pop(k, np.nan) for k in zip(keys, start.tolist())])
+        if final:                                           # every history is in: what is left has none
+            self.t_coll_of = {}
+        if final:
+            self.t_coll_of = {}
+        dt, window = self.dem.dt, flux.shape[1]
+        steps = t_coll / dt
+        cut = np.isfinite(steps) & (steps > window) & (filled == window)
+        if cut.any():
+            self.totals["heat_gran_undo_cut"] = self.totals.get("heat_gran_undo_cut", 0) + int(cut.sum())
+        share = np.clip(np.nan_to_num(steps)[:, None] - np.arange(window), 0.0, 1.0)
+        share[np.arange(window) >= filled[:, None]] = 0.0
+        q = dt * np.sum(flux * share, axis=1)              # heat heat/gran moved into i [J]
+        a, b = atoms.index(i), atoms.index(j)
+        ok = np.isfinite(t_coll) & (a >= 0) & (b >= 0) & (q != 0)
+        a, b, q = a[ok], b[ok], q[ok]
+        np.subtract.at(atoms.T, a, q / self.loop.C[a])
+        np.add.at(atoms.T, b, q / self.loop.C[b])
+        self.totals["heat_gran_undone"] += float(np.abs(q).sum())
+
+    def start_collisions(self, atoms, c, keys, rows) -> None:
+        i = atoms.index(c.i[rows])
+        wall, jl, mj, tj, R_j, m_j = self.partners(atoms, i, c.j[rows])
+        ti, R_i, m_i = atoms.type[i], atoms.radius[i], atoms.mass[i]
+        R_eff = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
+        m_eff = np.where(wall, m_i, m_i * m_j / np.where(wall, 1.0, m_i + m_j))
+        delta, approach = c.delta[rows], c.approach[rows]
+        v0 = np.abs(approach)
+        if self.dem.info.pair_model == "hertz":
+            for (a, b) in set(zip(ti.tolist(), tj.tolist())):
+                s = (ti == a) & (tj == b)
+                v0[s] = self.dem_law(a, b).impact_speed(delta[s], approach[s], R_eff[s], m_eff[s],
+                                                     window=self.loop.every["sample"] * self.dem.dt)
+        elif "model" not in self.warned:
+            self.warned.add("model")
+            print(f"warning: the DEM's normal model is '{self.dem.info.pair_model}', not hertz: impact speeds "
+                  "are the approach speeds at the first sample in contact, not integrated back to touch")
+        at = self.collide(atoms, c.i[rows], c.j[rows], v0, c.normal[rows], np.full(len(rows), self.loop.t))
+        self.info[rows] = at
+
+    def collide(self, atoms, ids_i, j, v0, normal, time, T_begin=None) -> np.ndarray:
+        """Collisions of particles ``ids_i`` with partners ``j`` (ids, or WALL_BASE + wall) at
+        impact speeds v0 [m/s] with unit normals (j to i), begun at ``time`` [s]: the plugin's
+        heat moved in this order, the totals and the collision log. Returns their OPEN_COLUMNS
+        rows. ``T_begin`` (n, 2) [K]: the two temperatures when each began (NaN: as now), where
+        something else (a fix heat/gran) changed them since: each collision's temperature
+        difference is the one it began with, plus what earlier collisions of this batch moved."""
+        i = atoms.index(ids_i)
+        wall, jl, mj, _, R_j, _ = self.partners(atoms, i, j)
+        mi, R_i = self.loop.materials_of(atoms.type[i]), atoms.radius[i]
+        rows = np.arange(len(i))
+        models = self.scene.effects.heat_models
+        model = models[0] if models else "none"
+        moved = e = t_coll = np.zeros(len(rows))
+        side = {}
+        if self.loop.heat:
+            shift = None
+            if T_begin is not None:         # (T_i - T_j) then minus now, before this batch
+                drift = T_begin - np.column_stack([atoms.T[i], np.where(wall, np.nan, atoms.T[np.where(wall, i, jl)])])
+                shift = np.nan_to_num(drift[:, 0]) - np.where(wall, 0.0, np.nan_to_num(drift[:, 1]))
+            args = (self.scene.effects.heat_path, self.loop.materials, mi, mj, R_i, R_j, v0, np.ones(len(rows)))
+            G, e, t_coll, flagged = evaluate_flagged(model, *args)              # Q per kelvin [J/K]
+            if flagged.any():
+                self.flag_outside_range(flagged, v0)
+            if len(models) > 1:         # side columns: the same collisions at the same dT, nothing moved
+                dT = temperature_difference(atoms.T, i, jl, self.T_wall) + (0.0 if shift is None else shift)
+                side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}
+            moved, capped, from_walls = exchange_heat(atoms.T, self.loop.C, i, jl, G, self.T_wall, shift)
+            self.totals["capped"] += capped
+            self.totals["heat_from_walls"] += from_walls
+            self.totals["heat_moved"] += float(np.abs(moved[~wall]).sum())
+            by_model = self.heat_by_model()
+            for m, q in zip(models, [moved] + list(side.values())):
+                by_model[m] += float(np.abs(q[~wall]).sum())
+        self.totals["collisions"] += len(rows)
+        self.totals["particle_wall"] += int(wall.sum())
+        self.totals["particle_particle"] += int((~wall).sum())
+        self.log.write_columns(time=time, i=ids_i, j=np.where(wall, 0, j),
+                                      wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
+                                      t_coll=t_coll, model=np.full(len(rows), model), **side)
+        return np.column_stack([time, t_coll, e, v0, normal])
+
+    def heat_by_model(self) -> dict:
+        """Heat between particles [J], sum of |Q| over collisions, of each heat model: the one
+        that moved it and the side models on the same collisions."""
+        return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
+
+    def end_collisions(self, atoms, closed, info) -> None:
+        """Contacts gone since the last sample (their keys and OPEN_COLUMNS rows): with
+        restitution feedback, the model's e imposed on the pair's normal velocity."""
+        if not self.scene.effects.restitution_feedback or not self.loop.heat:
+            return
+        ids_i = (closed >> 31).astype(np.int64)
+        ids_j = (closed & ((1 << 31) - 1)).astype(np.int64)
+        self.totals["clipped"] += self.impose_separation(atoms, ids_i, ids_j, info[:, 4:7], info[:, 2], info[:, 3])
+
+    def impose_separation(self, atoms, ids_i, ids_j, normal, e, v0) -> int:
+        """The model's separation speed e v0 [m/s] imposed now on each pair's normal velocity
+        (particles ``ids_i`` and ``ids_j``, or WALL_BASE + wall: the line of centres, nearest
+        image; a wall's ``normal`` as given), momentum conserved; skipped where a particle is
+        gone or e is NaN (contacts there at a restart: no collision). Returns how many e above
+        1 were clipped."""
+        i = atoms.index(ids_i)
+        here = (i >= 0) & ~np.isnan(e)
+        wall, jl, _, _, _, m_j = self.partners(atoms, np.maximum(i, 0), ids_j)
+        here &= wall | (jl >= 0)
+        normal = np.array(normal, float)
+        jj = np.where(wall, 0, np.maximum(jl, 0))
+        d = atoms.x[np.maximum(i, 0)] - atoms.x[jj]
+        lo, hi, periodic = self.dem.box()
+        d = np.where(periodic, d - (hi - lo) * np.round(d / (hi - lo)), d)
+        normal[~wall] = d[~wall] / np.linalg.norm(d[~wall], axis=1)[:, None]
+        v_j = np.where(wall[:, None], 0.0, atoms.v[jj])
+        dv_i, dv_j, clipped = restitution_impulse(atoms.v[np.maximum(i, 0)], v_j, atoms.mass[np.maximum(i, 0)],
+                                                  m_j, normal, e, v0)
+        self.dem.add_velocity(i[here], dv_i[here])
+        pair = here & ~wall
+        if pair.any():
+            self.dem.add_velocity(jl[pair], dv_j[pair])
+        return clipped
+
+    def undo_heat_gran(self, atoms, c) -> None:
+        """The script's fix heat/gran conducts through every contact; during a collision's
+        model duration t_coll the collision heat already stands for that time, so what heat/gran
+        moved then is taken back: flux at this sample [W] times the part of the sample interval
+        inside [start, start + t_coll] (exact when sampling every step)."""
+        dt_s = self.loop.every["sample"] * self.dem.dt
+        start, t_coll = self.info[:, 0], self.info[:, 1]
+        tau = np.clip(start + t_coll - (self.loop.t - dt_s), 0.0, dt_s)
+        rows = np.flatnonzero((tau > 0) & (c.j < WALL_BASE))
+        if not len(rows):
+            return
+        i, j = atoms.index(c.i[rows]), atoms.index(c.j[rows])
+        q = c.heat_flux[rows] * tau[rows]                   # heat heat/gran moved into i [J]
+        np.subtract.at(atoms.T, i, q / self.loop.C[i])
+        np.add.at(atoms.T, j, q / self.loop.C[j])
+        self.totals["heat_gran_undone"] += float(np.abs(q).sum())
+
+    def flush_events(self) -> None:
+        """The contact events recorded since the last harvest, taken now (a run stopped
+        between harvests: its checkpoint and summary hold every collision)."""
+        if self.events and self.loop.ready and (self.dem.events.waiting or self.dem.events.window):
+            atoms = self.dem.atoms(self.loop.heat)
+            self.loop.track_particles(atoms)
+            self.harvest(atoms, final=True)

@@ -1,0 +1,147 @@
+"""The fluid exchange: the fluid's force on each particle and the particles' fraction and drag
+to the fluid every coupling interval; with ``[effects] convection``, the gas-particle heat
+over the interval (particles' Temp at once, the opposite heat into the gas's cells). Its
+history columns: the bed's state (inlet velocity, pressure drop, height) and the gas's
+(temperature, heat content and what crossed). SI units."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from plugins import convection
+from pyhost.effects import Effect, by_id
+from pyhost.output import VtkSeries
+
+FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
+GAS_COLUMNS = ("T_gas_mean", "gas_energy", "heat_convected", "heat_convected_gross", "heat_through_fluid_boundaries",
+               "heat_moved")
+
+
+def layer_pressure_drop(fluid) -> float:
+    """Mean pressure [Pa] of the fluid's lowest cell layer less that of its highest. Layers
+    are matched with a tolerance: cell centres of one layer differ in their last digits."""
+    p, _ = fluid.fields()
+    z = fluid.cell_centres[:, 2]
+    tol = 1e-6 * (z.max() - z.min())
+    return float(p[z < z.min() + tol].mean() - p[z > z.max() - tol].mean())
+
+
+class FluidExchange(Effect):
+    """``fluid``: the running solver (pyhost.engines.openfoam.FluidSolver); ``logs``: the
+    checkpoint's output marks to continue from (None: a new run)."""
+
+    def __init__(self, loop, fluid, logs: dict | None = None):
+        super().__init__(loop)
+        self.fluid = fluid
+        self.convection = loop.effects["convection"]
+        self.columns = FLUID_COLUMNS + (GAS_COLUMNS if self.convection else ())
+        self.frames = (VtkSeries(loop.out / "vtk", "fluid", (logs or {}).get("fluid"))
+                       if loop.scene.output.vtk else None)
+        self.force = (np.zeros(0, np.int64), np.zeros((0, 3)))   # ids and force [N] of the last coupling
+        self.gas_energy0 = 0.0
+
+    def start(self) -> None:
+        T_gas = self.fluid.temperature() if self.convection else None
+        self.couple()
+        # the solver starts from the first fluid fraction it gets (no flow displaces the gas of
+        # the particles as placed): the gas's initial heat content with that fraction
+        self.gas_energy0 = float(np.sum(self.fluid.heat_capacity() * T_gas)) if self.convection else 0.0
+
+    def couple(self) -> None:
+        """The fluid's force on each particle from the current fluid, then the fluid advanced
+        over the next coupling interval with these particles' fraction and drag."""
+        loop = self.loop
+        atoms = loop.dem.atoms(temperature=self.convection)
+        lo, hi, periodic = loop.dem.box()
+        x = np.where(periodic, lo + np.mod(atoms.x - lo, hi - lo), atoms.x)   # the DEM wraps only at re-neighbouring
+        interval = loop.every["couple"] * loop.dem.dt
+        forces = self.fluid.particle_forces(x, atoms.v, 2.0 * atoms.radius)
+        self.fluid.advance(interval, heat=self.convect(atoms, interval) if self.convection else None)
+        loop.dem.set_force(forces)
+        self.force = (atoms.id.copy(), forces)
+
+    def convect(self, atoms, interval: float) -> np.ndarray:
+        """Gas-particle heat over the coming interval [s] (plugins.convection): each particle's
+        Temp takes its share now; returns the heat rate of each cell's gas [W], the opposite,
+        for the fluid's advance over the interval."""
+        loop, f, name = self.loop, self.fluid, self.loop.scene.effects.convection
+        loop.track_particles(atoms)
+        d = 2.0 * atoms.radius
+        alpha = f.alpha[f.cell]
+        re = convection.particle_reynolds(alpha, f.slip, d, f.nu)
+        pr = convection.prandtl(f.nu, f.rho, f.cp, f.kappa)
+        for key, share in convection.outside(name, re, pr, alpha).items():
+            if key not in loop.warned:
+                loop.warned.add(key)
+                lo, hi = convection.CORRELATIONS.lookup(name).validity[key]
+                print(f"warning: convection '{name}' extrapolated: {share:.1%} of the particles have {key} outside "
+                      f"[{lo:g}, {hi:g}] at t = {loop.t:g} s")
+        G = convection.conductance(name, re, pr, alpha, f.kappa, d)
+        q, _ = convection.exchange(atoms.T, loop.C, G, f.cell, f.temperature(), f.heat_capacity(), interval)
+        atoms.T[:] += q / loop.C
+        loop.totals["heat_convected"] += float(q.sum())
+        loop.totals["heat_convected_gross"] += float(np.abs(q).sum())
+        loop.track_particles(atoms)
+        return -np.bincount(f.cell, q, len(f.cell_volumes)) / interval
+
+    def row(self, atoms) -> tuple:
+        return self.bed_state(atoms) + (self.gas_state() if self.convection else ())
+
+    def bed_state(self, atoms) -> tuple:
+        """The fluid columns of history.csv: the superficial inlet velocity [m/s]; the pressure
+        drop the particles cause [Pa], mean p of the lowest cell layer less that of the highest,
+        less the fluid's own hydrostatic head between them; the bed height [m], twice the mean
+        particle centre height above the box floor (exact for a uniform bed)."""
+        loop = self.loop
+        z = self.fluid.cell_centres[:, 2]
+        head = self.fluid.rho * self.fluid.gravity()[2] * (z.max() - z.min())
+        floor = loop.dem.box()[0][2]
+        inlet = math.nan if loop.scene.fluid.case else float(loop.scene.fluid.inlet_at(loop.t))
+        return (inlet, layer_pressure_drop(self.fluid) + head,
+                2.0 * float(np.mean(atoms.x[:, 2] - floor)) if len(atoms.x) else math.nan)
+
+    def gas_state(self) -> tuple:
+        """The gas columns of history.csv: the heat-capacity weighted mean gas temperature [K],
+        the gas's heat content rho c alpha V T summed over cells [J]; since the start [J]: the
+        heat convected into the particles (net, and the sum of its magnitudes), the heat into
+        the gas through the fluid's boundaries, and beside them the heat moved by collisions
+        between particles (sum of magnitudes)."""
+        C = self.fluid.heat_capacity()
+        E = float(np.sum(C * self.fluid.temperature()))
+        t = self.loop.totals
+        return (E / C.sum(), E, t["heat_convected"], t["heat_convected_gross"], self.fluid.boundary_heat,
+                t["heat_moved"])
+
+    def frame(self) -> None:
+        if self.frames is not None:
+            p, u = self.fluid.fields()
+            self.frames.write(self.loop.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)
+
+    def flush(self) -> None:
+        if self.frames is not None:
+            self.frames.flush()
+
+    def state(self) -> tuple[dict, dict]:
+        return (dict(gas_energy0=self.gas_energy0, logs=dict(fluid=self.frames.frames if self.frames else None)),
+                dict(fluid_ids=self.force[0], fluid_force=self.force[1]))
+
+    def restore(self, state: dict) -> None:
+        """The fluid force of the last coupling, until the next."""
+        self.gas_energy0 = state.get("gas_energy0", 0.0)
+        ids, force = state["fluid_ids"], state["fluid_force"]
+        self.loop.dem.set_force(by_id(ids, force, self.loop.dem.atoms(False).id))
+        self.force = (ids, force)
+
+    def finish(self, summary: dict, status: str) -> None:
+        """With convection, the energy balance of particles and gas together (the gas gains
+        through its boundaries); the particles' own is the balance effect's."""
+        balance = self.loop.balance
+        if not (self.convection and status == "completed" and balance is not None and balance.residual is not None):
+            return
+        t = self.loop.totals
+        _, gas, _, _, through, _ = self.gas_state()
+        residual = balance.residual + (t["heat_convected"] + gas - self.gas_energy0 - through)
+        summary.update(gas_energy_start=self.gas_energy0, gas_energy_end=gas, heat_through_fluid_boundaries=through,
+                       total_energy_balance_error=residual / max(balance.came_in + self.gas_energy0 + abs(through),
+                                                                 1e-300))
