@@ -80,3 +80,36 @@ def test_plugins_import_nothing_of_the_host_and_the_host_nothing_of_tools():
     tools = {name: sorted(m for m in imports(f) if m.split(".")[0] == "tools") for name, f in mods.items()}
     assert {k: v for k, v in tools.items() if v} == {}
     assert not [name for name, f in mods.items() if "spec_from_file_location" in f.read_text()]
+
+
+def engine_uses(f: Path) -> set:
+    """Attributes the file takes of the DEM engine: ``X.dem.NAME`` or ``dem.NAME`` (not the
+    scene's ``scene.dem`` table)."""
+    used = set()
+    for node in ast.walk(ast.parse(f.read_text())):
+        if not isinstance(node, ast.Attribute):
+            continue
+        base = node.value
+        is_dem = (isinstance(base, ast.Name) and base.id == "dem") or (isinstance(base, ast.Attribute) and base.attr == "dem")
+        owner = base.value if isinstance(base, ast.Attribute) else None
+        of_scene = isinstance(owner, ast.Name) and owner.id == "scene" or isinstance(owner, ast.Attribute) and owner.attr == "scene"
+        if is_dem and not of_scene:
+            used.add(node.attr)
+    return used
+
+
+def test_the_loop_and_its_effects_use_only_the_engine_interface_and_dem_has_it_all():
+    """A second DEM engine is one file: the loop, its effects and the checkpoints ask nothing
+    of the engine outside pyhost.engines.interface, and LIGGGHTS' bridge implements all of it."""
+    from pyhost.engines.dem import Dem
+    from pyhost.engines.interface import MEMBERS
+
+    files = [ROOT / "pyhost" / "loop.py", ROOT / "pyhost" / "checkpoint.py",
+             *sorted((ROOT / "pyhost" / "effects").glob("*.py"))]
+    used = {f.name: sorted(engine_uses(f) - set(MEMBERS)) for f in files}
+    assert {k: v for k, v in used.items() if v} == {}
+    assert engine_uses(ROOT / "pyhost" / "loop.py") >= {"atoms", "run", "step", "dt"}   # the scan sees them
+    dem = Dem.__new__(Dem)
+    dem.info = dem.events = dem.link = None           # instance attributes, set by __init__
+    missing = [m for m in MEMBERS if not hasattr(dem, m) and not hasattr(Dem, m)]
+    assert missing == []

@@ -1,0 +1,123 @@
+"""What the loop, its effects and the checkpoints ask of a DEM engine: the whole interface a
+second engine implements in one file (as ``pyhost.engines.dem.Dem`` does for LIGGGHTS 3.8;
+LAMMPS' GRANULAR package, LIGGGHTS' maintained successor, is the likely next one).
+
+The engine runs a script command by command (the host's commands among them), advances in
+chunks of steps, and hands out the particles (``Atoms``) with writable temperatures. Contacts
+come either as events recorded inside the engine at every step (``events``: the recorder of
+``pyhost.engines.events``) or, without a recorder, as lists sampled between chunks
+(``contacts``). SI units throughout. ``tests/unit/test_structure.py`` checks that the loop and
+the effects use nothing of the engine outside this interface, and that ``Dem`` has all of it.
+"""
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+
+class DemEngine(Protocol):
+    """A DEM engine as the host drives it."""
+
+    # -- state -------------------------------------------------------------------------
+    info: object                 # what the script declared so far (pyhost.script.ScriptInfo): walls, heat/gran, computes
+    events: object | None        # the contact event recorder (pyhost.engines.events), None: contacts are sampled
+    link: object | None          # the other MPI ranks (pyhost.engines.ranks.Link), None when serial
+
+    @property
+    def dt(self) -> float:
+        """The time step [s]."""
+
+    @property
+    def step(self) -> int:
+        """The current step."""
+
+    # -- the script --------------------------------------------------------------------
+    def context(self, cmd) -> None:
+        """The script command about to run (named in the engine's errors)."""
+
+    def command(self, cmd) -> None:
+        """Run one script command (not a ``run``)."""
+
+    def engine_command(self, line: str) -> None:
+        """Run a command of the host's own (write_restart, ...)."""
+
+    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
+                events: bool = False) -> list[str]:
+        """Before the first run: add what the host needs (temperatures, contact computes or the
+        event recorder, the external force); returns the commands added, for the log."""
+
+    def steps(self, steps: str, upto: bool) -> int:
+        """The number of steps of a script's ``run N [upto]``."""
+
+    def run(self, steps: int) -> None:
+        """Advance ``steps`` steps (0: set up only)."""
+
+    def report_warnings(self, cmd=None) -> None:
+        """Say the engine's new warnings once."""
+
+    def close(self) -> None:
+        """End the engine."""
+
+    # -- particles ---------------------------------------------------------------------
+    def count(self) -> int:
+        """Particles in the simulation, on every rank."""
+
+    def box(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(lo [m], hi [m], periodic flags) of the domain."""
+
+    def atoms(self, temperature: bool = True):
+        """Every particle now (``pyhost.engines.dem.Atoms``), with a writable T [K] if asked;
+        writes into T and v reach the engine before its next step."""
+
+    def atoms_of(self, ids, temperature: bool = True):
+        """The particles with these ids only (MPI: only they are gathered)."""
+
+    def add_velocity(self, local_index, dv) -> None:
+        """Add dv [m/s] to the velocities of these atoms (indices into the last ``atoms``)."""
+
+    def set_force(self, force) -> None:
+        """The external force [N] on each atom (the fluid's), kept until set again."""
+
+    def per_atom(self, names) -> tuple:
+        """Per-atom arrays by name ("id", "f", "torque"), for a checkpoint."""
+
+    def put_per_atom(self, ids, **arrays) -> None:
+        """Per-atom arrays back by id (a restart's forces and torques)."""
+
+    # -- material values of the script ---------------------------------------------------
+    def type_values(self, prop: str, types) -> np.ndarray:
+        """A per-type property of the script (youngsModulus, poissonsRatio, thermalCapacity)."""
+
+    def type_pair_value(self, prop: str, a: int, b: int) -> float:
+        """A per-type-pair property of the script (coefficientRestitution) of types a, b."""
+
+    def has_heat_flux(self) -> bool:
+        """Whether the script's fix heat/gran's conduction per contact can be read."""
+
+    # -- contacts ----------------------------------------------------------------------
+    def event_planes(self, wall_index: dict) -> None:
+        """Hand the recorder the walls it records contacts with, by their host codes."""
+
+    def sampled_walls(self) -> bool:
+        """Whether some wall's contacts must still be sampled beside the recorder."""
+
+    def contacts(self, atoms, wall_index: dict):
+        """The contacts now (``pyhost.engines.dem.Contacts``), those the recorder does not take."""
+
+    # -- what a checkpoint keeps that the engine's restart does not ------------------------
+    def mesh_motion_times(self) -> dict:
+        """Each moving mesh's phase [s]."""
+
+    def set_mesh_motion_times(self, times: dict) -> None:
+        """Set each moving mesh's phase [s]."""
+
+    def random_states(self) -> dict:
+        """The insertion generators' states."""
+
+    def set_random_states(self, states: dict) -> None:
+        """Set the insertion generators' states."""
+
+
+MEMBERS = tuple(sorted({n for n in vars(DemEngine) if not n.startswith("_")} | set(DemEngine.__annotations__)))
+"""Every name of the interface."""
