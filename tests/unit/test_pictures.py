@@ -72,3 +72,26 @@ def test_particles_png(tmp_path, fluid):
     # the lower half of the fluid (alpha 0.4, the bottom of the grey map) is drawn black behind the particles
     black = np.sum(np.all(image < 30, axis=2))
     assert black > 0.1 * image.shape[0] * image.shape[1] if fluid else black < 0.02 * image.shape[0] * image.shape[1]
+
+
+def test_many_particles_are_drawn_as_sprites_that_cover_the_bed(tmp_path):
+    """Above GLYPHS_UP_TO particles they are point sprites of their mean diameter: a block of
+    6,000 touching particles still covers a good part of the picture in the colours of its
+    temperatures (not the white background)."""
+    from pyhost.pictures import GLYPHS_UP_TO
+
+    n = 6000
+    assert n > GLYPHS_UP_TO
+    (tmp_path / "history.csv").write_text("time,T_group0,collisions\n0.0,300.0,0\n0.01,300.5,7\n")
+    g = np.stack(np.meshgrid(*(np.arange(20),) * 2, np.arange(15), indexing="ij"), axis=-1).reshape(-1, 3)
+    x = (g + 0.5) * 0.002
+    particles = VtkSeries(tmp_path / "vtk", "particles")
+    for t, T in ((0.0, np.full(n, 300.0)), (0.01, 300.0 + 10.0 * (x[:, 2] > 0.015))):
+        particles.write(t, x, id=np.arange(1, n + 1), radius=np.full(n, 0.001), velocity=np.zeros((n, 3)),
+                        temperature=T)
+    particles.flush()
+    r = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    image = np.asarray(Image.open(tmp_path / "particles.png").convert("RGB")).astype(int)
+    coloured = np.sum(np.max(image, axis=2) - np.min(image, axis=2) > 40)     # red (hot) or blue (cold), not grey
+    assert coloured > 0.15 * image.shape[0] * image.shape[1]
