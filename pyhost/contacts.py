@@ -19,17 +19,33 @@ from pyhost.walls import face_overlap, primitive_overlap
 
 @dataclass(frozen=True)
 class Contacts:
-    """Current contacts: rows i (particle index), j (particle index or WALL_BASE + wall),
-    overlap delta [m], unit normal n (j to i), approach speed [m/s]."""
+    """Contacts, one row each: ``i`` a particle (index or atom id); ``j`` a particle, or
+    WALL_BASE + wall index; overlap ``delta`` [m]; unit ``normal`` from j to i; ``approach`` =
+    -(v_i - v_j).n [m/s] (> 0 while closing in); ``heat_flux`` [W] into i by a script's fix
+    heat/gran (zeros without). The one form of a contact list, whether from positions (here),
+    from LIGGGHTS' computes or from the walls' geometry (pyhost.engines.dem)."""
 
     i: np.ndarray
     j: np.ndarray
     delta: np.ndarray
     normal: np.ndarray
     approach: np.ndarray
+    heat_flux: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.heat_flux is None:
+            object.__setattr__(self, "heat_flux", np.zeros(len(self.i)))
 
     def __len__(self):
         return len(self.i)
+
+    @classmethod
+    def concat(cls, parts: list) -> "Contacts":
+        """The rows of several lists, in order."""
+        if not parts:
+            z = np.zeros(0)
+            return cls(np.zeros(0, np.int64), np.zeros(0, np.int64), z, np.zeros((0, 3)), z, z)
+        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.__dataclass_fields__))
 
 
 class ContactFinder:
@@ -84,7 +100,7 @@ class ContactFinder:
             delta, nw = face_overlap(x, r, wall, self.box) if isinstance(wall, str) else primitive_overlap(x, r, wall)
             k = np.flatnonzero(delta > 0)
             rows.append((k, np.full(len(k), WALL_BASE + w), delta[k], nw[k], -np.einsum("ij,ij->i", v[k], nw[k])))
-        return Contacts(*(np.concatenate([row[c] for row in rows]) for c in range(5)))
+        return Contacts.concat([Contacts(*row) for row in rows])
 
 
 def find_contacts(x, v, r, box, periodic=(False, False, False), walls=()) -> Contacts:

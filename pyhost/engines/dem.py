@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from pyhost.collisions import WALL_BASE
+from pyhost.contacts import Contacts
 from pyhost.walls import plane_of, primitive_overlap
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
@@ -61,30 +62,6 @@ class Atoms:
         lookup = np.full(int(max(self.id.max(initial=0), ids.max(initial=0))) + 1, -1, np.int64)
         lookup[self.id] = np.arange(len(self.id))
         return lookup[ids]
-
-
-@dataclass(frozen=True)
-class Contacts:
-    """Contacts now, one row each: ``i`` atom id; ``j`` atom id, or WALL_BASE + host wall index;
-    overlap ``delta`` [m]; unit ``normal`` from j to i; ``approach`` = -(v_i - v_j).n [m/s]
-    (> 0 while closing in); ``heat_flux`` [W] into i by the script's fix heat/gran (0 without)."""
-
-    i: np.ndarray
-    j: np.ndarray
-    delta: np.ndarray
-    normal: np.ndarray
-    approach: np.ndarray
-    heat_flux: np.ndarray
-
-    def __len__(self) -> int:
-        return len(self.i)
-
-
-def _concat(parts: list[Contacts]) -> Contacts:
-    if not parts:
-        z = np.zeros(0)
-        return Contacts(np.zeros(0, np.int64), np.zeros(0, np.int64), z, np.zeros((0, 3)), z, z)
-    return Contacts(*(np.concatenate([getattr(p, f) for p in parts]) for f in Contacts.__dataclass_fields__))
 
 
 class Dem:
@@ -470,7 +447,7 @@ class Dem:
             fix = mesh_fixes[-1]
             codes = [WALL_BASE + wall_index[fix, k] for k in range(len(self.info.walls[fix].meshes))]
             parts.append(self._mesh_contacts(atoms, np.array(codes, np.int64)))
-        return _concat(parts)
+        return Contacts.concat(parts)
 
     @collective
     def _local(self, which: str):

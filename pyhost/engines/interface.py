@@ -103,7 +103,7 @@ class DemEngine(Protocol):
         """Whether some wall's contacts must still be sampled beside the recorder."""
 
     def contacts(self, atoms, wall_index: dict):
-        """The contacts now (``pyhost.engines.dem.Contacts``), those the recorder does not take."""
+        """The contacts now (``pyhost.contacts.Contacts``), those the recorder does not take."""
 
     # -- what a checkpoint keeps that the engine's restart does not ------------------------
     def mesh_motion_times(self) -> dict:

@@ -94,8 +94,10 @@ def _declare(lib: ctypes.CDLL, table: dict) -> None:
 
 
 @dataclass(frozen=True)
-class Contacts:
-    """Contacts overlapping now, one row each (all SI).
+class ComputeRows:
+    """A contact compute's rows now, one contact each (all SI): the raw probe of LIGGGHTS'
+    ``pair/gran/local`` and ``wall/gran/local`` that the engine tests and benchmarks read; the
+    host's contact lists are ``pyhost.contacts.Contacts``, from ``pyhost.engines.dem.Dem``.
 
     ``i``, ``j``: atom ids (for a wall contact ``j`` is the wall's index); ``delta``: normal
     overlap (m); ``vi``, ``vj``: velocities of the two (m/s; ``vj`` is the wall's), so the
@@ -464,21 +466,21 @@ class Liggghts:
             return np.zeros(shape)
         return np.ctypeslib.as_array(data, shape=shape).copy()
 
-    def pair_contacts(self, compute_id: str = "pairs") -> Contacts:
-        """Particle-particle contacts now (see :class:`Contacts`)."""
+    def pair_contacts(self, compute_id: str = "pairs") -> ComputeRows:
+        """Particle-particle contacts now (see :class:`ComputeRows`)."""
         a = self._contact_array(compute_id)
-        return Contacts(i=a[:, 6].astype(np.int64), j=a[:, 7].astype(np.int64),
+        return ComputeRows(i=a[:, 6].astype(np.int64), j=a[:, 7].astype(np.int64),
                         delta=a[:, 10], vi=a[:, 0:3], vj=a[:, 3:6], area=a[:, 9])
 
-    def wall_contacts(self, compute_id: str = "walls") -> Contacts:
+    def wall_contacts(self, compute_id: str = "walls") -> ComputeRows:
         """Particle-mesh-wall contacts now: ``i`` the atom id, ``j`` the wall's index in
         its fix (from 0), ``vi`` the particle's and ``vj`` the wall's velocity (m/s)."""
         a = self._contact_array(compute_id)
         # LIGGGHTS' order for walls: wall velocity, particle velocity; wall, atom, triangle.
-        return Contacts(i=a[:, 7].astype(np.int64), j=a[:, 6].astype(np.int64),
+        return ComputeRows(i=a[:, 7].astype(np.int64), j=a[:, 6].astype(np.int64),
                         delta=a[:, 10], vi=a[:, 3:6], vj=a[:, 0:3], area=a[:, 9])
 
-    def plane_contacts(self, axis: int, position: float, wall: int = 0) -> Contacts:
+    def plane_contacts(self, axis: int, position: float, wall: int = 0) -> ComputeRows:
         """Contacts with a fixed primitive plane wall ``axis`` = ``position`` (axis 0, 1, 2
         for x, y, z; m), from geometry: overlap radius - distance (m), area of the cut
         circle pi (2 r delta - delta^2) (m^2), as LIGGGHTS reports for mesh walls; ``j`` is
@@ -486,7 +488,7 @@ class Liggghts:
         r, v = self.atom("radius"), self.atom("v")
         delta, _ = primitive_overlap(self.atom("x"), r, ("xyz"[axis] + "plane", (position,)))
         on = delta > 0
-        return Contacts(i=self.atom("id")[on].astype(np.int64), j=np.full(on.sum(), wall),
+        return ComputeRows(i=self.atom("id")[on].astype(np.int64), j=np.full(on.sum(), wall),
                         delta=delta[on], vi=v[on].copy(), vj=np.zeros((on.sum(), 3)),
                         area=np.pi * (2 * r[on] * delta[on] - delta[on] ** 2))
 
