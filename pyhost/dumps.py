@@ -167,6 +167,19 @@ def resolve_setup(lines: list[tuple[int, str]], path: Path) -> tuple[float | Non
     return dt, box, None
 
 
+def local_compute(path) -> str:
+    """The id of the compute whose rows a ``dump local`` file holds, from its first header
+    (``ITEM: ENTRIES c_ID[1] ...``); DumpError if it is unreadable or not such a dump."""
+    try:
+        with open_text(path) as f:
+            head = [f.readline() for _ in range(9)]
+    except STREAM_ERRORS as exc:
+        raise DumpError(path, None, 1, f"unreadable ({type(exc).__name__}: {exc})") from None
+    if not head[8].startswith("ITEM: ENTRIES c_"):
+        raise DumpError(path, None, 9, f"not a dump local of a compute: {head[8].strip()[:60]!r}")
+    return head[8].split()[2].split("[")[0][2:]
+
+
 def read_script(path) -> Script:
     """Reads ``timestep``, the local computes and the mesh wall fixes of a LIGGGHTS input
     (``&`` continuations and ``#`` comments handled; ``include`` is not followed)."""

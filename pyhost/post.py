@@ -27,16 +27,17 @@ from pathlib import Path
 
 import numpy as np
 
-from plugins.dem.hertz import DemHertz, hertz_collision_time
+from plugins.dem.hertz import DemHertz, hertz_collision_time, impact_speeds, reduced
 from plugins.heat.batch import dem_pair, evaluate_flagged
 from plugins.heat import MODELS
 from plugins.heat.exchange import exchange_heat
 from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.contacts import find_contacts
-from pyhost.dumps import STREAM_ERRORS, DumpError, DumpReader, expand, open_text
+from pyhost.dumps import DumpError, DumpReader, expand, local_compute
 from pyhost.outdir import write_atomic
 from pyhost.output import VtkSeries
-from pyhost.scene import Material, SceneError, Wall, _build, read_toml
+from pyhost.scene import read_toml
+from pyhost.schema import Material, SceneError, Wall, build
 from pyhost.walls import FACES
 
 MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
@@ -59,7 +60,7 @@ def load_post_scene(path) -> PostScene:
     data = read_toml(path)
     if not isinstance(data.get("materials"), dict) or not data["materials"]:
         raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
-    materials = {name: _build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
+    materials = {name: build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
     types = {}
     for k, (name, m) in enumerate(materials.items()):
         for t in m.types:
@@ -73,7 +74,7 @@ def load_post_scene(path) -> PostScene:
         raise SceneError(f"{file}: materials: no material names its LIGGGHTS atom types (types = [1, 2])")
     if not isinstance(data.get("walls", []), list):
         raise SceneError(f"{file}: walls: must be [[walls]] tables")
-    walls = [_build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+    walls = [build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
     for k, wall in enumerate(walls):
         if wall.material not in materials:
             raise SceneError(f"{file}: walls[{k}].material: unknown material {wall.material!r}; "
@@ -241,15 +242,7 @@ class Post:
         """Contact dump files grouped by the compute their columns come from (one stream each)."""
         streams = {}
         for p in expand(self.contacts):
-            try:
-                with open_text(p) as f:
-                    head = [f.readline() for _ in range(9)]
-            except STREAM_ERRORS as exc:
-                raise DumpError(p, None, 1, f"unreadable ({type(exc).__name__}: {exc})") from None
-            cid = head[8].split()[2].split("[")[0][2:] if head[8].startswith("ITEM: ENTRIES c_") else None
-            if cid is None:
-                raise DumpError(p, None, 9, f"not a dump local of a compute: {head[8].strip()[:60]!r}")
-            streams.setdefault(cid, []).append(p)
+            streams.setdefault(local_compute(p), []).append(p)
         return streams
 
     def dump_contacts(self, found: Found) -> None:
@@ -392,15 +385,11 @@ class Post:
         return laws
 
     def impact_speeds(self, c) -> np.ndarray:
-        mi, mj, R_i, R_j, m_i, m_j, wall, _ = self.bodies(c["i"], c["j"])
-        R = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
-        m = np.where(wall, m_i, m_i * m_j / np.where(wall, 1.0, m_i + m_j))
-        v0 = c["approach"].copy()
-        for (a, b), (_, law) in self.dem_laws(mi, mj).items():
-            s = (mi == a) & (mj == b) & (c["delta"] > 0)
-            for window in np.unique(c["window"][s]):
-                w = s & (c["window"] == window)
-                v0[w] = law.impact_speed(c["delta"][w], c["approach"][w], R[w], m[w], window=window or None)
+        mi, mj, R_i, R_j, m_i, m_j, _, _ = self.bodies(c["i"], c["j"])
+        R, m = reduced(R_i, R_j, m_i, m_j)
+        laws = self.dem_laws(mi, mj)
+        v0 = impact_speeds(c["approach"], lambda a, b: laws[a, b][1], mi, mj, c["delta"], c["approach"], R, m,
+                           c["window"], mask=c["delta"] > 0)
         self.shortest_collision(mi, mj, R, m, v0)
         return v0
 

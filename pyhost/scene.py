@@ -47,7 +47,7 @@ from pathlib import Path
 
 from plugins.heat import MODELS
 from pyhost.schema import (Dem, Domain, Effects, Fluid, Material, Output, Particles,  # noqa: F401
-                           Scene, SceneError, Time, Wall, _build)   # the schema's names, re-exported for the commands
+                           Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
 from pyhost.validate import check_raw, check_scene, read_text
 
 
@@ -94,7 +94,7 @@ def load_scene(path) -> Scene:
     for key in data:
         if key not in SECTIONS:
             raise SceneError(f"{file}: {key}: unknown section; known: {', '.join(SECTIONS)}")
-    dem = _build(Dem, data.get("dem", {}), "dem", file)
+    dem = build(Dem, data.get("dem", {}), "dem", file)
     scripted = bool(dem.script)
     required = ("materials",) if scripted else ("materials", "particles", "domain", "time")
     for key in required:
@@ -107,16 +107,16 @@ def load_scene(path) -> Scene:
                                  "and sets the domain): remove it")
         _script_keys(dem, path, file)
     check_raw(data, file)
-    effects = _build(Effects, data.get("effects", {}), "effects", file)
+    effects = build(Effects, data.get("effects", {}), "effects", file)
     if not isinstance(data["materials"], dict) or not data["materials"]:
         raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
-    materials = {name: _build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
+    materials = {name: build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
     for name, m in materials.items():
         if m.b2 <= m.b1:
             raise SceneError(f"{file}: materials.{name}.b2: must exceed b1 ({m.b1}), got {m.b2}")
     if not isinstance(data.get("walls", []), list):
         raise SceneError(f"{file}: walls: must be [[walls]] tables")
-    walls = [_build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+    walls = [build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
     if scripted:
         particles, domain = [], None
         _types(materials, walls, file)
@@ -130,14 +130,14 @@ def load_scene(path) -> Scene:
         if item.material not in materials:
             raise SceneError(f"{file}: walls[{k}].material: unknown material {item.material!r}; "
                              f"known: {', '.join(materials)}")
-    time = _build(Time, data.get("time", {}), "time", file)
+    time = build(Time, data.get("time", {}), "time", file)
     if not scripted:
         for key in ("dem_step", "end"):
             if not getattr(time, key) > 0:
                 raise SceneError(f"{file}: time.{key}: must be > 0, got {getattr(time, key)!r}")
         if time.dem_step >= time.end:
             raise SceneError(f"{file}: time.dem_step: must be below time.end ({time.end}), got {time.dem_step}")
-    fluid = _build(Fluid, data["fluid"], "fluid", file) if "fluid" in data else None
+    fluid = build(Fluid, data["fluid"], "fluid", file) if "fluid" in data else None
     if effects.restitution_feedback and (not effects.heat_models or effects.heat_models[0] not in MODELS):
         raise SceneError(f"{file}: effects.restitution_feedback: needs a contact model ({', '.join(sorted(MODELS))}) "
                          f"first in effects.contact_heat; comparison models give no restitution")
@@ -154,7 +154,7 @@ def load_scene(path) -> Scene:
         raise SceneError(f"{file}: fluid.cells: must be 3 positive integers, got {fluid.cells!r}")
     if fluid is not None and fluid.inlet_table:
         _inlet_table(fluid, file)
-    output = _build(Output, data.get("output", {}), "output", file)
+    output = build(Output, data.get("output", {}), "output", file)
     scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem)
     check_scene(scene)
     return scene
@@ -226,7 +226,7 @@ def _box_world(data, materials, walls, file):
                              "(dem.script); here [[particles]] give them")
     if not isinstance(data["particles"], list) or not data["particles"]:
         raise SceneError(f"{file}: particles: must be one or more [[particles]] tables")
-    particles = [_build(Particles, p, f"particles[{k}]", file) for k, p in enumerate(data["particles"])]
+    particles = [build(Particles, p, f"particles[{k}]", file) for k, p in enumerate(data["particles"])]
     for k, w in enumerate(walls):
         if not w.plane or w.fix:
             raise SceneError(f"{file}: walls[{k}]: a box scene names its wall by plane = \"zlo\" (etc.), "
@@ -245,7 +245,7 @@ def _box_world(data, materials, walls, file):
         if p.positions and len(p.positions) != p.count:
             raise SceneError(f"{file}: particles[{k}].positions: {len(p.positions)} given, count = {p.count}")
         _box(p.velocity, f"particles[{k}].velocity", file, 3)
-    domain = _build(Domain, data["domain"], "domain", file)
+    domain = build(Domain, data["domain"], "domain", file)
     _box(domain.box, "domain.box", file)
     _box(domain.gravity, "domain.gravity", file, 3)
     return particles, domain

@@ -1,6 +1,6 @@
 """The scene's schema: the frozen dataclasses a ``case.toml`` is built into (``pyhost.scene``
 reads and checks it), each field's rule, default and meaning (``spec``), ``SceneError``, and
-``_build``, which fills a dataclass from one TOML table. SI units. It imports no other part
+``build``, which fills a dataclass from one TOML table. SI units. It imports no other part
 of the host but the walls, so that everything that takes a scene (the checks, the LIGGGHTS
 input) can import it without going round in a circle through the loader.
 """
@@ -257,7 +257,10 @@ class Scene:
         )
 
 
-def _build(cls, data, where: str, file: str):
+def build(cls, data, where: str, file: str):
+    """The dataclass ``cls`` filled from one TOML table ``data`` (at key ``where`` of ``file``):
+    every key known, every value of its type and within its rule; SceneError naming the file
+    and the key otherwise. A missing key takes its default (or is an error if it has none)."""
     if not isinstance(data, dict):
         raise SceneError(f"{file}: {where}: must be a table, got {type(data).__name__}")
     fields = {f.name: f for f in dataclasses.fields(cls)}
@@ -276,7 +279,7 @@ def _build(cls, data, where: str, file: str):
         if type(None) in typing.get_args(kind):         # an optional table: X | None
             kind = next(k for k in typing.get_args(kind) if k is not type(None))
         if dataclasses.is_dataclass(kind):
-            values[name] = _build(kind, value, key, file)
+            values[name] = build(kind, value, key, file)
             continue
         if kind is float and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)

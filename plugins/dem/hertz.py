@@ -34,6 +34,32 @@ def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
     return 1.0 / ((1 - np.square(nu1)) / E1 + (1 - np.square(nu2)) / E2)
 
 
+def reduced(R_i, R_j, m_i, m_j):
+    """(R* [m], m* [kg]) of each contact of bodies of radii R and masses m: R_i R_j / (R_i + R_j)
+    and m_i m_j / (m_i + m_j); against a wall (R_j, m_j inf) the particle's own R_i, m_i."""
+    wall = np.isinf(R_j)
+    return (np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j)),
+            np.where(wall, m_i, m_i * m_j / np.where(wall, 1.0, m_i + m_j)))
+
+
+def impact_speeds(v0, law_of, key_i, key_j, delta, approach, Rstar, mstar, window, mask=None):
+    """Normal impact speeds [m/s] of contacts first seen at overlap delta [m] with approach speed
+    [m/s]: for the contacts of each pair of keys (atom types, or materials), that pair's DEM law
+    ``law_of(a, b)`` (a ``DemHertz``) integrated back to touch (``DemHertz.impact_speed``) over
+    ``window`` [s] (per contact, 0 for none); ``v0`` elsewhere, and outside ``mask``. The one
+    recovery of impact speeds from sampled contacts, for the run and for post."""
+    v0 = np.array(v0, float)
+    window = np.broadcast_to(np.asarray(window, float), np.shape(delta))
+    take = np.ones(len(v0), bool) if mask is None else mask
+    for a, b in set(zip(np.asarray(key_i)[take].tolist(), np.asarray(key_j)[take].tolist())):
+        s = take & (key_i == a) & (key_j == b)
+        for w in np.unique(window[s]):
+            rows = s & (window == w)
+            v0[rows] = law_of(a, b).impact_speed(delta[rows], approach[rows], Rstar[rows], mstar[rows],
+                                                 window=w or None)
+    return v0
+
+
 def hertz_collision_time(Estar, Rstar, mstar, v):
     """Duration [s] of an elastic Hertz impact at speed v [m/s] with effective modulus Estar
     [Pa], radius Rstar [m] and mass mstar [kg] (eq. 32)."""

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from plugins.dem.hertz import DemHertz, effective_modulus
+from plugins.dem.hertz import DemHertz, effective_modulus, impact_speeds, reduced
 from plugins.dem.impulse import restitution_impulse
 from plugins.heat.batch import evaluate_flagged, side_heat
 from plugins.heat.exchange import exchange_heat, temperature_difference
@@ -332,16 +332,12 @@ class CollisionHeat(Effect):
     def start_collisions(self, atoms, c, keys, rows) -> None:
         i = atoms.index(c.i[rows])
         wall, jl, mj, tj, R_j, m_j = self.partners(atoms, i, c.j[rows])
-        ti, R_i, m_i = atoms.type[i], atoms.radius[i], atoms.mass[i]
-        R_eff = np.where(wall, R_i, R_i * R_j / np.where(wall, 1.0, R_i + R_j))
-        m_eff = np.where(wall, m_i, m_i * m_j / np.where(wall, 1.0, m_i + m_j))
+        R_eff, m_eff = reduced(atoms.radius[i], R_j, atoms.mass[i], m_j)
         delta, approach = c.delta[rows], c.approach[rows]
         v0 = np.abs(approach)
         if self.dem.info.pair_model == "hertz":
-            for (a, b) in set(zip(ti.tolist(), tj.tolist())):
-                s = (ti == a) & (tj == b)
-                v0[s] = self.dem_law(a, b).impact_speed(delta[s], approach[s], R_eff[s], m_eff[s],
-                                                     window=self.loop.every["sample"] * self.dem.dt)
+            v0 = impact_speeds(v0, self.dem_law, atoms.type[i], tj, delta, approach, R_eff, m_eff,
+                               self.loop.every["sample"] * self.dem.dt)
         elif "model" not in self.warned:
             self.warned.add("model")
             print(f"warning: the DEM's normal model is '{self.dem.info.pair_model}', not hertz: impact speeds "
