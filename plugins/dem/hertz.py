@@ -14,7 +14,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 from scipy.special import beta as beta_fn
 
 K_HERTZ = 0.4 * beta_fn(0.4, 0.5)
@@ -164,6 +163,7 @@ class DemHertz:
         return np.sqrt(E)
 
     def _back_in_time(self, d1, v1, R, m):
+        from scipy.integrate import solve_ivp  # here: 0.15 s to import, and most runs never come here
         rhs = lambda t, y: [y[1], -self.force(max(y[0], 0.0), y[1], R, m) / m]
         touch = lambda t, y: y[0]
         touch.terminal, touch.direction = True, 0

@@ -19,7 +19,6 @@ from functools import lru_cache
 
 import numpy as np
 from numpy.polynomial import Chebyshev
-from scipy.optimize import brentq
 from scipy.special import betainc, betaincc
 
 from plugins.dem.hertz import K_HERTZ  # noqa: F401  (re-exported: the 1.472 of eqs. 23 and 29)
@@ -164,6 +163,7 @@ class Stronge:
             f = lambda L: float(self.work_drop(1.0 + L, L)) - target
             if f(self.x_p - 1.0) <= 0.0:      # v within rounding of v_p
                 return self.x_p
+            from scipy.optimize import brentq  # here: scipy.optimize takes 0.3 s to import, the fast path never needs it
             L = brentq(f, 0.0, self.x_p - 1.0, xtol=1e-300, rtol=1e-15, maxiter=200)
             return 1.0 + L
         X = math.sqrt(self.X_p**2 + 4.0 * (0.4 * v * v - self.W_p) / self.beta)
