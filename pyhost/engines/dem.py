@@ -29,6 +29,7 @@ from pyhost.contacts import Contacts
 from pyhost.walls import plane_of, primitive_overlap
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
+from pyhost.engines.events import RECORDED
 from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_values, put_by_id, set_random_states, write_local)
 from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
@@ -405,8 +406,9 @@ class Dem:
     # -- contacts ---------------------------------------------------------------------
     def sampled_walls(self) -> bool:
         """Whether some wall's contacts must still be sampled beside the event recorder (mesh
-        walls it could not take)."""
-        return any(w.meshes and not self._mesh_events for w in self.info.walls.values())
+        walls it could not take, primitive kinds it does not know)."""
+        return any((w.meshes and not self._mesh_events) or (w.primitive is not None and w.primitive[0] not in RECORDED)
+                   for w in self.info.walls.values())
 
     def event_planes(self, wall_index: dict) -> None:
         """The primitive plane, cylinder and mesh walls, for the event recorder, with their
@@ -427,15 +429,13 @@ class Dem:
 
     def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:
         """Every contact now (see :class:`Contacts`); with the event recorder, only those it
-        does not record: mesh walls without a neighbour list. ``wall_index``: host wall index of each
+        does not record: mesh walls without a neighbour list, primitive kinds not in RECORDED. ``wall_index``: host wall index of each
         (wall/gran fix id, mesh index in the fix); a particle touching several triangles of one
         mesh is one contact (the deepest)."""
         events = self.events is not None
         parts = [] if events else [self._pair_contacts(atoms)]
         for fix, wall in self.info.walls.items():
-            if events and wall.primitive is not None:
-                continue
-            if wall.primitive is not None:
+            if wall.primitive is not None and not (events and wall.primitive[0] in RECORDED):
                 parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix, 0]))
         mesh_fixes = [f for f, w in self.info.walls.items() if w.meshes and not (events and self._mesh_events)]
         if mesh_fixes and self.info.wall_compute is None:

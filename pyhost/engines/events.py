@@ -30,6 +30,10 @@ import numpy as np
 from pyhost.engines.collective import collective
 
 FIX = "collheat_events"
+RECORDED = frozenset({"xplane", "yplane", "zplane", "xcylinder", "ycylinder", "zcylinder"})
+"""The primitive wall kinds (``pyhost.walls.PRIMITIVES``) whose contacts the recorder notes
+(``planes``, ``cylinders``; plugins/liggghts/contact_events.cpp). A kind of pyhost.walls that
+is not here has its contacts sampled from its geometry beside the recorder."""
 ROW = 12
 BEGIN, END = 0, 1
 EVENT = np.dtype([("kind", np.int8), ("wall", np.bool_), ("step", np.int64), ("i", np.int64), ("j", np.int64),
