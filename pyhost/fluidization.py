@@ -2,7 +2,7 @@
 
 A run whose ``fluid.inlet_table`` holds the velocity in steps (plateaus) writes, in
 history.csv, the superficial inlet velocity, the pressure drop the particles cause and the
-bed height (``Coupling.bed_state``). Here each plateau is averaged over the second half of
+bed height (``pyhost.effects.fluid.FluidExchange.bed_state``). Here each plateau is averaged over the second half of
 its hold, and compared with
 
 - Ergun (1952) at the bed's own voidage and height, for the fixed bed;

@@ -33,8 +33,8 @@ def exchange_heat(T, C, i, j, G, T_wall=None, shift=None):
     T [K] and C = m c [J/K] are per particle; j >= WALL_BASE is wall j - WALL_BASE, with
     temperature T_wall[wall] (None or NaN: adiabatic, no exchange). ``shift`` [K] per collision,
     if given, is added to its T_i - T_j (temperatures that changed since the collision by what
-    it does not stand for: pyhost.loop's contact events). No collision carries more
-    heat than would equalise the two temperatures: a G above C_i C_j/(C_i + C_j) (C_i for a
+    it does not stand for: a script's fix heat/gran between a contact event and its harvest).
+    No collision carries more heat than would equalise the two temperatures: a G above C_i C_j/(C_i + C_j) (C_i for a
     wall) is capped there. Returns the heat moved per collision [J], the number capped, and
     the heat that entered the particles from walls [J]; sum(C T) changes by exactly that.
 
