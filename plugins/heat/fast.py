@@ -16,18 +16,13 @@ and takes a Horner step. Speeds outside [V_MIN, V_MAX] v_y go through the exact 
 """
 from __future__ import annotations
 
-import hashlib
-import io
 import math
-import os
-import warnings
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from plugins.heat import exact
+from plugins.heat import exact, table_cache
 from plugins.heat.compression import compression_law
 from plugins.heat.models import MODELS
 from plugins.heat.pair import Pair
@@ -38,14 +33,6 @@ H = 0.01                         # q spacing of the nodes for models with regime
 H_SMOOTH = 0.1                   # u spacing for model B, smooth in u = ln(v0/v_y)
 COLUMNS = ("x_max", "t_max", "t_coll", "e", "Q")
 CHUNK = 32768                    # collisions per block (measured best of 4096..65536)
-
-
-class CacheWarning(UserWarning):
-    """A cached table was damaged and has been rebuilt."""
-
-
-def _cache_dir() -> Path:
-    return Path(os.environ.get("COLLHEAT_CACHE", Path.home() / ".cache" / "collheat"))
 
 
 class Table:
@@ -124,52 +111,20 @@ class Table:
         return out
 
 
-@lru_cache(maxsize=1)
-def source_digest(root: Path = Path(__file__).parents[1]) -> str:
-    """SHA-256 of every Python file of the heat plugin (the models in models/ included) and of
-    the DEM plugin it takes the Hertz constants from, with their paths: the tables depend on
-    all of them, so an edited file gives a new cache key."""
-    h = hashlib.sha256()
-    for f in sorted(f for part in ("heat", "dem") for f in (root / part).rglob("*.py")):
-        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
-    return h.hexdigest()
-
-
 @lru_cache(maxsize=32)
 def table(model: str, b1: float, b2: float, c: float, spacing: float | None = None) -> Table:
     """The table of ``model`` for (b1, b2, c): from memory, else from the disk cache
-    (COLLHEAT_CACHE, default ~/.cache/collheat), else built (a few seconds) and cached.
-    The cache key holds the plugin's source, so a changed model never reads an old table;
-    a checksum beside each table catches a damaged file, which is rebuilt with a CacheWarning.
-    ``spacing`` other than None (the default H / H_SMOOTH) builds a table of that node
-    spacing, cached under its own key."""
+    (``plugins.heat.table_cache``: COLLHEAT_CACHE, default ~/.cache/collheat), else built (a
+    few seconds) and cached. ``spacing`` other than None (the default H / H_SMOOTH) builds a
+    table of that node spacing, cached under its own key."""
     ident = (model, b1, b2, c) if spacing is None else (model, b1, b2, c, float(spacing))
-    key = hashlib.sha256(repr(ident).encode() + source_digest().encode()).hexdigest()[:16]
-    path = _cache_dir() / f"table-{model}-{key}.npy"
-    check = path.with_suffix(".sha256")
     tab = Table.__new__(Table)
-    try:
-        raw = path.read_bytes()
-        if hashlib.sha256(raw).hexdigest() != check.read_text().strip():
-            raise ValueError("checksum mismatch")
-        tab.__dict__.update(np.load(io.BytesIO(raw), allow_pickle=True).item())
+    state = table_cache.load(model, ident)
+    if state is not None:
+        tab.__dict__.update(state)
         return tab
-    except FileNotFoundError:
-        pass
-    except Exception as exc:        # whatever a damaged file makes the unpickler raise
-        warnings.warn(f"table cache {path} is corrupt ({exc}); rebuilding it", CacheWarning, stacklevel=2)
     tab = Table(model, b1, b2, c, spacing)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        buffer = io.BytesIO()
-        np.save(buffer, np.array(tab.__dict__, dtype=object), allow_pickle=True)
-        for target, data in ((check, hashlib.sha256(buffer.getvalue()).hexdigest().encode()),
-                             (path, buffer.getvalue())):
-            tmp = target.with_name(f"{target.name}.tmp{os.getpid()}")
-            tmp.write_bytes(data)
-            os.replace(tmp, target)
-    except OSError:
-        pass
+    table_cache.save(model, ident, tab.__dict__)
     return tab
 
 

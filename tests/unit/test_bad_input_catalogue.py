@@ -466,6 +466,7 @@ def test_collision_inside_validity_has_no_flag(capsys):
 
 def test_corrupt_table_cache_is_rebuilt_with_a_warning(tmp_path, monkeypatch):
     from plugins.heat import fast
+    from plugins.heat.table_cache import CacheWarning
     monkeypatch.setenv("COLLHEAT_CACHE", str(tmp_path))
     fast.table.cache_clear()
     try:
@@ -475,13 +476,13 @@ def test_corrupt_table_cache_is_rebuilt_with_a_warning(tmp_path, monkeypatch):
         data = bytearray(stored.read_bytes())
         data[len(data) // 2] ^= 0xFF
         stored.write_bytes(bytes(data))
-        with pytest.warns(fast.CacheWarning, match="corrupt"):
+        with pytest.warns(CacheWarning, match="corrupt"):
             again = fast.collide_fast([1.0], model="B")["Q"]
         assert again == good
         fast.table.cache_clear()
         import warnings
         with warnings.catch_warnings():
-            warnings.simplefilter("error", fast.CacheWarning)   # the rebuilt table is sound
+            warnings.simplefilter("error", CacheWarning)   # the rebuilt table is sound
             assert fast.collide_fast([1.0], model="B")["Q"] == good
     finally:
         fast.table.cache_clear()

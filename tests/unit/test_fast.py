@@ -64,11 +64,11 @@ def test_table_cache_key_changes_when_any_plugin_file_changes(tmp_path, edited):
     table is never read."""
     import shutil
     from pathlib import Path
-    from plugins.heat import fast
+    from plugins.heat import fast, table_cache
     root = tmp_path / "plugins"
     for part in ("heat", "dem"):
         shutil.copytree(Path(fast.__file__).parents[1] / part, root / part, ignore=shutil.ignore_patterns("__pycache__"))
-    before = fast.source_digest.__wrapped__(root)
-    assert fast.source_digest.__wrapped__(root) == before
+    before = table_cache.source_digest.__wrapped__(root)
+    assert table_cache.source_digest.__wrapped__(root) == before
     (root / edited).write_text((root / edited).read_text() + "\n# edited\n")
-    assert fast.source_digest.__wrapped__(root) != before
+    assert table_cache.source_digest.__wrapped__(root) != before

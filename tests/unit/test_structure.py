@@ -113,3 +113,21 @@ def test_the_loop_and_its_effects_use_only_the_engine_interface_and_dem_has_it_a
     dem.info = dem.events = dem.link = None           # instance attributes, set by __init__
     missing = [m for m in MEMBERS if not hasattr(dem, m) and not hasattr(Dem, m)]
     assert missing == []
+
+
+def test_the_plugins_python_is_pure_but_for_the_table_cache():
+    """plugins/ does no I/O except plugins/heat/table_cache.py (the fast path's tables on
+    disk): no other module imports os, io, pathlib, shutil, tempfile or calls open()."""
+    io_modules = {"os", "io", "pathlib", "shutil", "tempfile"}
+    found = {}
+    for name, f in modules().items():
+        if not name.startswith("plugins") or name == "plugins.heat.table_cache":
+            continue
+        tree = ast.parse(f.read_text())
+        names = {a.name.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+        names |= {n.module.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module}
+        opens = any(isinstance(n, ast.Call) and isinstance(n.func, ast.Name) and n.func.id == "open"
+                    for n in ast.walk(tree))
+        if names & io_modules or opens:
+            found[name] = sorted(names & io_modules) + (["open()"] if opens else [])
+    assert found == {}
