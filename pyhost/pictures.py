@@ -7,6 +7,18 @@ from pathlib import Path
 import numpy as np
 
 
+def warm_up() -> None:
+    """Import the drawing libraries (matplotlib, pyvista: about 1 s), so that a picture process
+    started with a run has them when the run ends (``pyhost.commands.pictures``)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot  # noqa: F401
+    import pyvista
+    import pyvista.plotting  # noqa: F401  (pyvista imports its plotting at first use)
+    pyvista.OFF_SCREEN = True
+    pyvista.Plotter(off_screen=True).close()     # the off-screen render context, once
+
+
 def plot_history(out: Path) -> Path:
     """Change of each particle group's mean temperature (heat-capacity weighted) since the
     start, and the collision count, against time -> out/temperatures.png. Changes, because a

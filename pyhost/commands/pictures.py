@@ -1,7 +1,8 @@
 """``python -m pyhost pictures OUT``: pictures of a finished (or interrupted) run's output.
 
 A separate process on purpose: Debian's libliggghts loads Debian's VTK 9.1, which clashes
-with the VTK that pyvista brings (a segfault when both are in one process).
+with the VTK that pyvista brings (a segfault when both are in one process). ``run`` starts it
+with the run (``painter``), so that its imports (about 1 s) overlap the simulation.
 """
 from __future__ import annotations
 
@@ -28,9 +29,36 @@ def run(args) -> int:
     return 0
 
 
+def painter(out: Path):
+    """A picture process for the run writing into ``out``, started now: it imports the drawing
+    libraries while the run goes on (on another core) and draws when ``draw(painter)`` is
+    called; closing its input without that (a failed run) ends it without drawing."""
+    import subprocess
+    import sys
+    return subprocess.Popen([sys.executable, "-m", "pyhost.commands.pictures", str(out), "--when-told"],
+                            stdin=subprocess.PIPE)
+
+
+def draw(p) -> int:
+    """Tell a ``painter`` to draw now; its exit code once done."""
+    try:
+        p.stdin.write(b"draw\n")
+        p.stdin.close()
+    except BrokenPipeError:               # it died early: its exit code says how
+        pass
+    return p.wait()
+
+
 if __name__ == "__main__":      # what `run` starts: the same, without building every command's parser
     import sys
     from pyhost.cli import UserError
+    if sys.argv[2:] == ["--when-told"]:
+        import signal
+        signal.signal(signal.SIGINT, signal.SIG_IGN)   # a Ctrl-C is the run's to handle: it ends this process
+        from pyhost.pictures import warm_up
+        warm_up()
+        if sys.stdin.readline().strip() != "draw":
+            sys.exit(0)                  # the run failed: no pictures
     try:
         sys.exit(run(argparse.Namespace(out=Path(sys.argv[1]))))
     except UserError as exc:

@@ -4,9 +4,10 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import subprocess
 import sys
 from pathlib import Path
+
+from pyhost.commands.pictures import draw, painter
 
 HELP = "run a case: DEM (+ fluid) with collision heat as its case.toml asks"
 
@@ -78,10 +79,17 @@ def run_case(args, link) -> int:
     write_atomic(out / "scene.json", json.dumps(resolved(scene), indent=1, default=str))
     if link is not None:
         print(f"MPI: LIGGGHTS on {link.size} ranks; the host on rank 0")
-    summary = simulate(scene, out, test=args.test, resume=resume, link=link)
+    pictures = painter(out) if scene.output.pictures else None   # own process, warming up meanwhile
+    try:
+        summary = simulate(scene, out, test=args.test, resume=resume, link=link)
+    except BaseException:
+        if pictures is not None:      # no pictures of a failed run
+            pictures.kill()
+            pictures.wait()
+        raise
     print("summary:", json.dumps(summary, indent=1))
-    if scene.output.pictures:        # own process: see pyhost/commands/pictures.py
-        drawn = subprocess.run([sys.executable, "-m", "pyhost.commands.pictures", str(out)])
-        if drawn.returncode != 0:
-            print(f"warning: pictures failed (exit {drawn.returncode}); the run's data are in {out}")
+    if pictures is not None:
+        code = draw(pictures)
+        if code != 0:
+            print(f"warning: pictures failed (exit {code}); the run's data are in {out}")
     return 0

@@ -95,3 +95,18 @@ def test_many_particles_are_drawn_as_sprites_that_cover_the_bed(tmp_path):
     image = np.asarray(Image.open(tmp_path / "particles.png").convert("RGB")).astype(int)
     coloured = np.sum(np.max(image, axis=2) - np.min(image, axis=2) > 40)     # red (hot) or blue (cold), not grey
     assert coloured > 0.15 * image.shape[0] * image.shape[1]
+
+
+def test_the_painter_started_with_a_run_draws_when_told_and_not_otherwise(tmp_path):
+    """``run`` starts the picture process with the run (its imports overlap the simulation):
+    told to draw, it writes both pictures; its input closed without that (a failed run), it
+    ends at once with exit 0 and draws nothing."""
+    from pyhost.commands.pictures import draw, painter
+
+    write_run(tmp_path, fluid=False)
+    idle = painter(tmp_path)
+    idle.stdin.close()
+    assert idle.wait(timeout=60) == 0
+    assert not list(tmp_path.glob("*.png"))
+    assert draw(painter(tmp_path)) == 0
+    assert (tmp_path / "temperatures.png").stat().st_size > 0 and (tmp_path / "particles.png").stat().st_size > 0
