@@ -312,8 +312,6 @@ class CollisionHeat(Effect):
         t_coll = np.array([self.t_coll_of.pop(k, np.nan) for k in zip(keys, start.tolist())])
         if final:                                           # every history is in: what is left has none
             self.t_coll_of = {}
-        if final:
-            self.t_coll_of = {}
         dt, window = self.dem.dt, flux.shape[1]
         steps = t_coll / dt
         cut = np.isfinite(steps) & (steps > window) & (filled == window)
