@@ -42,7 +42,7 @@ from pyhost.script import ScriptError, parse_run, replay
 
 HARVEST_EVERY = 1000
 """DEM steps between harvests of the contact events at most (they are also taken at every
-frame, fluid exchange, checkpoint and sample): bounds the recorder's buffer and the wait of a
+frame, checkpoint and sample, and at a fluid exchange that reads temperatures): bounds the recorder's buffer and the wait of a
 signal (a stop is taken between two DEM chunks)."""
 
 

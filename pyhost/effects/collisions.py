@@ -85,7 +85,7 @@ class CollisionHeat(Effect):
         if self.events and self.harvest_alone(due):
             self.harvest_partly()
             return None
-        if not (due["sample"] or (self.events and any(due.values()))):
+        if not (due["sample"] or (self.events and self.wants_harvest(due))):
             return None
         atoms = self.dem.atoms(loop.heat)
         loop.track_particles(atoms)
@@ -94,6 +94,16 @@ class CollisionHeat(Effect):
         if due["sample"]:
             self.sample_contacts(atoms)
         return atoms
+
+    def wants_harvest(self, due: dict) -> bool:
+        """Whether this chunk's end needs the events taken now: a harvest, a frame, a sample or a
+        checkpoint is due, or a fluid exchange that reads the temperatures (convection) or
+        comes while a fix heat/gran conducts. A fluid exchange without either changes no
+        temperature and reads none: the events wait for the next of the others, in larger
+        batches (the heat moved is the same, collision after collision in their order)."""
+        convects = self.loop.fluid_exchange is not None and self.loop.fluid_exchange.convection
+        return any(due[k] for k in ("harvest", "frame", "sample", "checkpoint")) or (
+            due["couple"] and (convects or bool(self.dem.events.window)))
 
     def end_of_run(self, atoms) -> None:
         """At the end of each of the script's runs: the events so far."""
