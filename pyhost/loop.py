@@ -42,8 +42,8 @@ from pyhost.script import ScriptError, parse_run, replay
 
 HARVEST_EVERY = 1000
 """DEM steps between harvests of the contact events at most (they are also taken at every
-frame, checkpoint and sample, and at a fluid exchange that reads temperatures): bounds the recorder's buffer and the wait of a
-signal (a stop is taken between two DEM chunks)."""
+frame, checkpoint and sample, and at a fluid exchange that reads temperatures): bounds the
+recorder's buffer and the wait of a signal (a stop is taken between two DEM chunks)."""
 
 
 @dataclass(frozen=True)
