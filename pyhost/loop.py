@@ -100,8 +100,7 @@ class Coupling:
         if resume is None and self.balance is not None:
             self.balance.begin(dem.atoms(True))
         self.fluid_exchange = FluidExchange(self, fluid, logs) if fluid is not None else None
-        others = [e for e in (self.fluid_exchange,) if e is not None]
-        self.frames = Frames(self, groups, others, logs)
+        self.frames = Frames(self, groups, [self.fluid_exchange] if fluid is not None else [], logs)
         self.effect_list = [e for e in (self.balance, self.collisions, self.fluid_exchange, self.frames) if e is not None]
         self.progress = Progress(end or math.inf, progress_every)
         events = self.collisions is not None and self.collisions.events
