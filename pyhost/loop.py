@@ -265,8 +265,13 @@ class Coupling:
             if status == "completed":
                 raise
             print(f"warning: the collisions since the last harvest are not in the log ({type(err).__name__}: {err})")
-        for effect in self.effect_list:
-            effect.flush()
+        for effect in self.effect_list:      # (the fluid: its last advance, if it runs beside the DEM)
+            try:
+                effect.flush()
+            except Exception as err:
+                if status == "completed":
+                    raise
+                print(f"warning: {type(err).__name__} at the end of a run that stopped: {err}")
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
         self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
         summary = dict(self.totals, status=status, time=self.t, steps=self.steps, groups=self.frames.group_names)

@@ -164,6 +164,10 @@ class Fluid:
                                "after decomposePar; the box mesh is cut into slabs across x or y, whichever has "
                                "more cells; a user's case needs its own system/decomposeParDict with that many "
                                "subdomains)")
+    overlap: str = spec("in:auto,always,never", "auto",
+                        "whether the fluid advances while the DEM runs the same coupling interval, in "
+                        "parallel (the results are the same): auto does so in a serial run when this "
+                        "machine has a core for each fluid rank beside the DEM's, not under mpirun")
 
     @property
     def prandtl(self) -> float:

@@ -27,6 +27,11 @@ absolute times are only indicative; both codes run one after the other in this o
     .venv/bin/python tools/bench_dpmfoam.py                 # --time 0.01: about 5 min
     .venv/bin/python tools/bench_dpmfoam.py --time 0.02 --keep
 
+Each code gets as many cores as ranks: serially the host's fluid takes turns with the DEM
+(``[fluid] overlap = "never"``), as DPMFoam's fluid and particles do in one process; with
+``--beside`` it advances beside the DEM on a second core (the default of a serial run on a
+machine with one free, docs/mpi.md), which DPMFoam cannot.
+
 ``--np N`` (N > 1) runs both on N ranks: DPMFoam decomposed (method simple, N slabs along
 y) under mpirun; the host as ``mpirun -np N python -m pyhost run`` (LIGGGHTS decomposed,
 docs/mpi.md) with ``[fluid] ranks = N`` (collheatFoam decomposed in N slabs along y, like
@@ -119,8 +124,9 @@ def dpmfoam(case: Path, end: float, np: int) -> dict:
                 particles=int(parcels[-1]) if parcels else None)
 
 
-def host(folder: Path, end: float, np: int) -> dict:
-    """``python -m pyhost run`` on a copy of bed-25k running ``end`` seconds."""
+def host(folder: Path, end: float, np: int, beside: bool = False) -> dict:
+    """``python -m pyhost run`` on a copy of bed-25k running ``end`` seconds (serially on one
+    core at a time, unless ``beside``)."""
     case = folder / "case"
     case.mkdir(parents=True)
     text = (CASE / "case.toml").read_text()
@@ -130,6 +136,8 @@ def host(folder: Path, end: float, np: int) -> dict:
             raise SystemExit(f"{CASE / 'case.toml'}: no '{key} =' line in [time]")
     if np > 1:
         text = text.replace("\n[fluid]\n", f"\n[fluid]\nranks = {np}\n", 1)
+    elif not beside:
+        text = text.replace("\n[fluid]\n", '\n[fluid]\noverlap = "never"\n', 1)
     (case / "case.toml").write_text(text + "pictures = false\n")     # [output] is the last table
     log = folder / "log.run"
     wall, _ = run_logged([*mpirun(np), sys.executable, "-m", "pyhost", "run", str(case), "--out", str(folder / "output")],
@@ -147,6 +155,8 @@ def main(argv=None) -> int:
     p.add_argument("--time", type=float, default=0.01, help="simulated time of each run [s] (default 0.01)")
     p.add_argument("--np", type=int, default=1, help="MPI ranks of each code (default 1)")
     p.add_argument("--keep", action="store_true", help="keep the run folders (printed)")
+    p.add_argument("--beside", action="store_true",
+                   help="serially, the host's fluid beside its DEM on a second core (default: one core, taking turns)")
     a = p.parse_args(argv)
     if a.time < 5 * DPMFOAM_STEP:
         p.error(f"--time must be at least {5 * DPMFOAM_STEP:g} s (5 DPMFoam steps)")
@@ -155,10 +165,10 @@ def main(argv=None) -> int:
     tmp = Path(tempfile.mkdtemp(prefix="bench_dpmfoam_"))
     try:
         t0 = time.perf_counter()
-        ours = host(tmp / "bed-25k", a.time, a.np)
+        ours = host(tmp / "bed-25k", a.time, a.np, a.beside)
         theirs = dpmfoam(copy_tutorial(tmp / "Goldschmidt"), a.time, a.np)
         print(f"bed of the Goldschmidt tutorial, {a.time:g} s of bed time from the initial placement, "
-              f"{a.np} rank(s); one run on a shared machine ({time.perf_counter() - t0:.0f} s)")
+              f"{a.np} rank(s){', the fluid beside the DEM' if a.beside and a.np == 1 else ''}; one run on a shared machine ({time.perf_counter() - t0:.0f} s)")
         print(f"DPMFoam: {theirs['particles']} parcels, {theirs['steps']} steps of {DPMFOAM_STEP:g} s; "
               f"bed-25k: {ours['particles']} particles, {ours['collisions']} collisions (heat A, fast)")
         print(f"{'':10s} {'total wall [s]':>15s} {'wall s / sim s':>15s} {'marching wall s / sim s':>24s}")

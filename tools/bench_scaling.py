@@ -14,8 +14,11 @@ Compare them as ratios: the machine may be shared.
 
 With ``--case CASE`` (e.g. cases/bed-25k): that case as it is (fluid included) for ``--time``
 s, heat as its scene says against none, with the share of OpenFOAM (collheatFoam's
-exchanges and steps, timed on rank 0) beside LIGGGHTS' and the host's; the fluid solver runs
-on as many ranks as LIGGGHTS (``[fluid] ranks``).
+exchanges and steps, timed on rank 0, including the wait for an advance that ran beside the
+DEM) beside LIGGGHTS' and the host's; the fluid solver runs on as many ranks as LIGGGHTS
+(``[fluid] ranks``). The serial run is measured twice: the engines taking turns (``[fluid]
+overlap = "never"``: one process works at a time, the time of one core) and the fluid advancing
+beside the DEM ("auto": two cores); the speed-up is against the first.
 
 Run: .venv/bin/python tools/bench_scaling.py [--particles 1000 10000 100000] [--ranks 1 2]
      [--time 2e-4] [--repeat 1] [--case cases/bed-25k]
@@ -99,7 +102,9 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
         base = load_scene(Path(os.environ["BENCH_CASE"]).resolve() / "case.toml")
         scene = variant(base, sim_time, contact_heat=heat)
         if scene.fluid is not None:     # the fluid on as many ranks as LIGGGHTS
-            scene = dataclasses.replace(scene, fluid=dataclasses.replace(scene.fluid, ranks=comm.Get_size() if comm is not None else 1))
+            scene = dataclasses.replace(scene, fluid=dataclasses.replace(
+                scene.fluid, ranks=comm.Get_size() if comm is not None else 1,
+                overlap=os.environ.get("BENCH_OVERLAP", scene.fluid.overlap)))
     timed = {}
 
     def wrap(dem):
@@ -127,11 +132,12 @@ def worker(n: int, sim_time: float, heat: str, out: Path) -> None:
                           balance=summary.get("energy_balance_error"))))
 
 
-def measure(n: int, ranks: int, sim_time: float, heat: str, tmp: Path, case: Path | None = None) -> dict:
+def measure(n: int, ranks: int, sim_time: float, heat: str, tmp: Path, case: Path | None = None,
+            overlap: str = "auto") -> dict:
     cmd = [sys.executable, __file__, "--worker", str(n), str(sim_time), heat, str(tmp / f"{heat}-{n}-{ranks}")]
     if ranks > 1:
         cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
-    env = dict(ENV, BENCH_CASE=str(case)) if case else ENV
+    env = dict(ENV, BENCH_CASE=str(case), BENCH_OVERLAP=overlap) if case else ENV
     done = subprocess.run(cmd, env=env, capture_output=True, text=True)
     if done.returncode != 0:
         raise SystemExit(f"run failed: {' '.join(cmd)}\n{done.stdout[-2000:]}{done.stderr[-2000:]}")
@@ -181,19 +187,22 @@ def bench_case(args) -> None:
     without, and where the heat-on run's time went."""
     from pyhost.scene import load_scene
 
-    heat = load_scene(args.case.resolve() / "case.toml").effects.contact_heat
+    scene = load_scene(args.case.resolve() / "case.toml")
+    heat = scene.effects.contact_heat
     print(f"{args.case}: {args.time:g} s simulated per run from its initial state, heat {heat} against none; "
           f"best of {args.repeat}; one run of this script")
-    print(f"{'ranks':>5} | {'plain wall s/s':>14} | {'heat wall s/s':>13} | {'ratio':>5} | {'collisions':>10} | "
+    runs_of = [(r, o) for r in args.ranks for o in (("never", "auto") if r == 1 and scene.fluid is not None else ("auto",))]
+    print(f"{'ranks':>12} | {'plain wall s/s':>14} | {'heat wall s/s':>13} | {'ratio':>5} | {'collisions':>10} | "
           f"{'RSS max/sum MB':>14} | {'LIGGGHTS':>8} | {'OpenFOAM':>8} | {'host':>5} | {'speed-up':>8}")
     with tempfile.TemporaryDirectory() as tmp:
         first = None
-        for ranks in args.ranks:
-            runs = {h: min((measure(0, ranks, args.time, h, Path(tmp), args.case) for _ in range(args.repeat)),
+        for ranks, overlap in runs_of:
+            runs = {h: min((measure(0, ranks, args.time, h, Path(tmp), args.case, overlap) for _ in range(args.repeat)),
                            key=lambda r: r["wall"]) for h in ("none", heat)}
             p, h = runs["none"], runs[heat]
             first = first or h["wall"]
-            print(f"{ranks:>5} | {p['wall'] / args.time:14.0f} | {h['wall'] / args.time:13.0f} | "
+            label = f"{ranks}" + {"never": " (turns)", "auto": " (beside)" if ranks == 1 and scene.fluid else ""}[overlap]
+            print(f"{label:>12} | {p['wall'] / args.time:14.0f} | {h['wall'] / args.time:13.0f} | "
                   f"{h['wall'] / p['wall']:5.2f} | {h['collisions']:>10} | "
                   f"{h['rss_max_mb']:6.0f}/{h['rss_sum_mb']:<7.0f} | {h['in_dem'] / h['wall']:8.0%} | "
                   f"{h['in_fluid'] / h['wall']:8.0%} | {1 - (h['in_dem'] + h['in_fluid']) / h['wall']:5.0%} | "

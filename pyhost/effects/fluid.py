@@ -6,6 +6,7 @@ history columns: the bed's state (inlet velocity, pressure drop, height) and the
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
@@ -16,6 +17,17 @@ from pyhost.output import VtkSeries
 FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
 GAS_COLUMNS = ("T_gas_mean", "gas_energy", "heat_convected", "heat_convected_gross", "heat_through_fluid_boundaries",
                "heat_moved")
+
+
+def overlapping(setting: str, dem_ranks: int, fluid_ranks: int) -> bool:
+    """Whether the fluid advances while the DEM runs its next chunk (``[fluid] overlap``).
+    "auto": when the two fit on this process's cores side by side, a serial DEM and the
+    fluid's ranks; not under mpirun, where the ranks are bound to cores and the fluid, started
+    by rank 0, would share rank 0's. The results are the same either way: the advance uses the
+    particles of the exchange before it, and the DEM's chunk the forces of that exchange."""
+    if setting != "auto":
+        return setting == "always"
+    return dem_ranks == 1 and 1 + fluid_ranks <= len(os.sched_getaffinity(0))
 
 
 def layer_pressure_drop(fluid) -> float:
@@ -40,6 +52,8 @@ class FluidExchange(Effect):
                        if loop.scene.output.vtk else None)
         self.force = (np.zeros(0, np.int64), np.zeros((0, 3)))   # ids and force [N] of the last coupling
         self.gas_energy0 = 0.0
+        link = loop.dem.link
+        self.overlap = overlapping(loop.scene.fluid.overlap, 1 if link is None else link.size, loop.scene.fluid.ranks)
 
     def start(self) -> None:
         T_gas = self.fluid.temperature() if self.convection else None
@@ -50,14 +64,16 @@ class FluidExchange(Effect):
 
     def couple(self) -> None:
         """The fluid's force on each particle from the current fluid, then the fluid advanced
-        over the next coupling interval with these particles' fraction and drag."""
+        over the next coupling interval with these particles' fraction and drag (with
+        ``overlap``, while the DEM runs that interval: the next use of the fluid waits for it)."""
         loop = self.loop
         atoms = loop.dem.atoms(temperature=self.convection)
         lo, hi, periodic = loop.dem.box()
         x = np.where(periodic, lo + np.mod(atoms.x - lo, hi - lo), atoms.x)   # the DEM wraps only at re-neighbouring
         interval = loop.every["couple"] * loop.dem.dt
         forces = self.fluid.particle_forces(x, atoms.v, 2.0 * atoms.radius)
-        self.fluid.advance(interval, heat=self.convect(atoms, interval) if self.convection else None)
+        self.fluid.advance(interval, heat=self.convect(atoms, interval) if self.convection else None,
+                           wait=not self.overlap)
         loop.dem.set_force(forces)
         self.force = (atoms.id.copy(), forces)
 
@@ -119,6 +135,7 @@ class FluidExchange(Effect):
             self.frames.write(self.loop.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)
 
     def flush(self) -> None:
+        self.fluid.wait()
         if self.frames is not None:
             self.frames.flush()
 

@@ -65,9 +65,11 @@ class FluidCaseError(ValueError):
 
 def _exchange(method):
     """Marks a request/answer exchange: while one is under way the pipes hold half a
-    message, so :meth:`FluidSolver.stop` must end the solver instead of asking it to stop."""
+    message, so :meth:`FluidSolver.stop` must end the solver instead of asking it to stop.
+    An advance still under way (``advance(wait=False)``) is waited for first."""
     @functools.wraps(method)
     def wrapper(self, *args, **kwargs):
+        self.wait()
         self._busy = True
         result = method(self, *args, **kwargs)
         self._busy = False
@@ -152,12 +154,13 @@ class FluidSolver:
                 raise FluidError(f"{self.case}: the gas energy needs 0/T and Cp, kappa in "
                                  f"constant/transportProperties; missing: {', '.join(missing) or '0/T'}")
             self.cp, self.kappa = _value(props["Cp"]), _value(props["kappa"])
-        self.boundary_heat = 0.0     # J into the gas through the case's boundaries so far
+        self._boundary_heat = 0.0    # J into the gas through the case's boundaries so far
         self.log = self.case / "log.collheatFoam"
         self.proc: subprocess.Popen | None = None
         self._fds: list[tuple[int, int]] = []
         self._busy = False
-        self.time = 0.0
+        self._pending = False        # an advance sent whose answers are not read yet
+        self._time = 0.0
         self.restart = None if restart is None else Path(restart)
 
     # -- life cycle -------------------------------------------------------------------
@@ -234,6 +237,7 @@ class FluidSolver:
             return
         try:
             if self.proc.poll() is None and not self._busy and _state(self.proc.pid) != "T":
+                self.wait()
                 for rank in range(self.nprocs):
                     self._send(rank, np.int32(STOP).tobytes())
                 for rank in range(self.nprocs):
@@ -284,14 +288,14 @@ class FluidSolver:
         control = FoamFile(self.case / "system" / "controlDict")
         control["startFrom"] = "startTime"
         control["startTime"] = float(name)
-        self.time = float(name)
+        self._time = float(name)
 
     def _resume(self, folder: Path) -> None:
         """At the end of a :meth:`start` from ``folder``: the host's side of the last exchange."""
         with np.load(folder / "host.npz") as saved:
             self._alpha, self._ksl, self._us = saved["alpha"], saved["ksl"], saved["us"]
             self.cell, self.slip = saved["cell"], saved["slip"]
-            self.boundary_heat = float(saved["boundary_heat"])
+            self._boundary_heat = float(saved["boundary_heat"])
         if len(self._alpha) != len(self.cell_volumes):
             raise FluidError(f"{folder}: the saved fluid has {len(self._alpha)} cells, the case "
                              f"{len(self.cell_volumes)}")
@@ -384,12 +388,16 @@ class FluidSolver:
         return cell, u, gradp
 
     @_exchange
-    def advance(self, duration: float, steps: int = 1, heat: np.ndarray | None = None) -> float:
+    def advance(self, duration: float, steps: int = 1, heat: np.ndarray | None = None,
+                wait: bool = True) -> float | None:
         """Advance the fluid by ``duration`` (s) in ``steps`` equal time steps with the
         particle fields of the last :meth:`particle_forces`; returns the fluid time (s).
         With the gas energy, ``heat`` (W per cell, default none) goes into each cell's gas
         over the interval, and what entered through the boundaries adds to
-        ``boundary_heat`` (J)."""
+        ``boundary_heat`` (J). ``wait=False``: return (None) once the request is sent; the
+        solver steps while the host goes on (the DEM's next chunk), and the next use of the
+        solver, :meth:`wait` or :meth:`stop` takes its answer first (a failed step raises
+        there)."""
         if duration <= 0 or steps < 1:
             raise ValueError(f"need duration > 0 and steps >= 1, got {duration}, {steps}")
         if heat is not None and not self.energy:
@@ -402,11 +410,37 @@ class FluidSolver:
             self._send(rank, head + self._alpha[a:b].tobytes() + self._ksl[a:b].tobytes()
                        + np.ascontiguousarray(self._us[a:b]).tobytes()
                        + (heat[a:b].tobytes() if self.energy else b""))
+        self._pending = True
+        if wait:
+            self.wait()
+            return self._time
+        return None
+
+    def wait(self) -> None:
+        """The answer of an advance sent with ``wait=False``, if one is under way: its time
+        and the heat through the boundaries. Raises FluidError if the solver failed in it."""
+        if not self._pending:
+            return
+        self._pending = False
+        self._busy = True
         for rank in range(self.nprocs):
-            self.time = float(self._read(rank, np.float64, 1)[0])
+            self._time = float(self._read(rank, np.float64, 1)[0])
             if self.energy:
-                self.boundary_heat += float(self._read(rank, np.float64, 1)[0])
-        return self.time
+                self._boundary_heat += float(self._read(rank, np.float64, 1)[0])
+        self._busy = False
+
+    @property
+    def time(self) -> float:
+        """The fluid's time [s], after the advance under way if one is."""
+        self.wait()
+        return self._time
+
+    @property
+    def boundary_heat(self) -> float:
+        """Heat into the gas through the case's boundaries so far [J], with the advance under
+        way if one is."""
+        self.wait()
+        return self._boundary_heat
 
     def couple(self, x, v, d, duration: float, steps: int = 1) -> np.ndarray:
         """One coupling step: the force on each particle (N) from the current fluid, then the
@@ -452,8 +486,8 @@ class FluidSolver:
         for rank in range(self.nprocs):
             self._send(rank, np.int32(WRITE).tobytes())
         for rank in range(self.nprocs):
-            self.time = float(self._read(rank, np.float64, 1)[0])
-        return self.time
+            self._time = float(self._read(rank, np.float64, 1)[0])
+        return self._time
 
     # -- pipes ------------------------------------------------------------------------
     def _failed(self, what: str, waited: float | None = None) -> FluidError | FluidCaseError:

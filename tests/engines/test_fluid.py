@@ -208,6 +208,40 @@ def test_diverging_run_raises_with_the_solver_message(tmp_path):
         assert fluid.advance(5e-3) == pytest.approx(5e-3)
 
 
+def test_an_advance_left_to_run_gives_the_same_fluid_and_waits_at_the_next_use(tmp_path):
+    """lid_box with 200 moving particles, 10 couplings: each advance sent with wait=False (the
+    host free while the solver steps, as beside the DEM's chunk) against waiting for each. The
+    forces, p and U equal to the last bit; the fluid time and the next request take the answer
+    first."""
+    rng = np.random.default_rng(10011)
+    x0 = rng.uniform((0.002, 0.001, 0.002), (0.038, 0.009, 0.038), (200, 3))
+    v = rng.normal(0, 0.05, (200, 3))
+    results = []
+    for wait in (True, False):
+        with FluidSolver(lid_box(tmp_path / f"wait{wait}", 1), drag="difelice") as fluid:
+            for k in range(10):
+                x = np.clip(x0 + 2e-3 * k * v, 1e-4, (0.0399, 0.0099, 0.0399))
+                force = fluid.particle_forces(x, v, 1e-3)
+                assert fluid.advance(5e-3, wait=wait) == (pytest.approx(5e-3 * (k + 1)) if wait else None)
+            assert fluid.time == pytest.approx(0.05)
+            results.append((force, *fluid.fields()))
+    for waited, overlapped in zip(*results):
+        assert np.array_equal(waited, overlapped)
+
+
+def test_a_failed_advance_left_to_run_raises_at_the_next_use(tmp_path):
+    """The diverging case of the test above with every advance sent with wait=False: the
+    failure is raised (FluidError naming the divergence) by the next request, not lost."""
+    case = box_case(tmp_path / "bad", lo=(0, 0, 0), hi=(0.01, 0.001, 0.01), cells=(10, 1, 10),
+                    dt=1.0, max_speed=100.0, n_correctors=1,
+                    boundaries={"xlo": ("inlet", (50, 0, 0)), "xhi": "outlet", "ylo": "slip",
+                                "yhi": "slip", "zlo": "wall", "zhi": "wall"}, **WATER)
+    with pytest.raises(FluidError, match="diverged"):
+        with FluidSolver(case) as fluid:
+            for _ in range(50):
+                assert fluid.advance(1.0, wait=False) is None
+
+
 @pytest.mark.parametrize("nprocs", [1, 2])
 def test_fluid_restarted_from_its_saved_state_continues_bit_for_bit(tmp_path, nprocs):
     """lid_box with 200 particles moving under it: 10 couplings, ``save`` (every field with 17

@@ -116,3 +116,17 @@ def test_solver_path_not_executable(fake):
     openfoam.SOLVER.chmod(0o644)
     message, _ = timed_failure(lambda: fluid.__enter__())
     assert "cannot start the fluid solver" in message and str(openfoam.SOLVER) in message
+
+
+def test_the_fluid_runs_beside_the_dem_only_where_both_have_cores(monkeypatch):
+    """[fluid] overlap: "always" and "never" as said; "auto" for a serial DEM when its cores
+    hold one more process per fluid rank, never under mpirun (ranks bound to cores)."""
+    from pyhost.effects import fluid
+
+    assert fluid.overlapping("always", 4, 4) and not fluid.overlapping("never", 1, 1)
+    monkeypatch.setattr(fluid.os, "sched_getaffinity", lambda pid: {0, 1})
+    assert fluid.overlapping("auto", 1, 1)
+    assert not fluid.overlapping("auto", 1, 2)          # 3 processes on 2 cores
+    assert not fluid.overlapping("auto", 2, 1)          # under mpirun
+    monkeypatch.setattr(fluid.os, "sched_getaffinity", lambda pid: {0})
+    assert not fluid.overlapping("auto", 1, 1)
