@@ -24,6 +24,9 @@ delta_max / v0 (the 1.472 of eqs. 23 and 29)."""
 def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
     """E* = [(1 - nu1^2)/E1 + (1 - nu2^2)/E2]^-1 [Pa] (Kosinski et al. 2014, sec. 3.1.1,
     after eq. 4; LIGGGHTS' Yeff). Young's moduli E [Pa], Poisson ratios nu [-]."""
+    if all(type(a) is float for a in (E1, nu1, E2, nu2)) and 0 < E1 < math.inf and 0 < E2 < math.inf \
+            and -1 < nu1 < 0.5 and -1 < nu2 < 0.5:         # plain valid numbers: no numpy round trip
+        return 1.0 / ((1 - nu1 * nu1) / E1 + (1 - nu2 * nu2) / E2)
     for name, value in (("E1", E1), ("E2", E2)):
         if not (np.all(np.asarray(value) > 0) and np.all(np.isfinite(value))):
             raise ValueError(f"{name} must be a positive finite Young's modulus [Pa], got {value!r}")

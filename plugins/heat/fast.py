@@ -153,7 +153,8 @@ def collide_fast(v0, pair: Pair | None = None, model: str = "A", outputs=exact.O
     tab = table(MODELS.lookup(model).name, float(pair.b1), float(pair.b2), float(pair.log_constant))
     shape = np.broadcast_shapes(v0.shape, *(np.shape(getattr(pair, f)) for f in PAIR_FIELDS))
     n = math.prod(shape)
-    flat = lambda a: np.asarray(a, float) if np.ndim(a) == 0 else np.broadcast_to(a, shape).ravel()
+    flat = lambda a: (np.asarray(a, float) if np.ndim(a) == 0 else
+                      np.asarray(a, float).ravel() if np.shape(a) == shape else np.broadcast_to(a, shape).ravel())
     v0 = np.broadcast_to(v0, shape).ravel()
     sc = {k: flat(getattr(pair, k)) for k in SCALES}
     out = {k: np.empty(n) for k in outputs}

@@ -60,8 +60,13 @@ class Pair:
     def __post_init__(self) -> None:
         positive = ("R1", "rho1", "rho2", "Estar", "Y", "b1", "b2", "c1", "c2", "k1", "k2")
         for name in positive + ("R2",):
-            value = np.asarray(getattr(self, name), dtype=float)
-            if not np.all(value > 0) or (name != "R2" and not np.all(value < np.inf)):
+            value = getattr(self, name)
+            if type(value) in (float, int):      # a plain number (most fields): no numpy round trip
+                ok = 0 < value < math.inf or (name == "R2" and value == math.inf)
+            else:
+                value = np.asarray(value, dtype=float)
+                ok = np.all(value > 0) and (name == "R2" or np.all(value < np.inf))
+            if not ok:
                 raise ValueError(f"{name} must be positive and finite{' (or inf)' if name == 'R2' else ''}, "
                                  f"got {getattr(self, name)!r}")
         if not np.all(np.isfinite(np.asarray(self.dT, dtype=float))):
