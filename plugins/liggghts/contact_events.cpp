@@ -122,6 +122,15 @@ struct Recorder {
     std::vector<uint64_t> key;                 // the contact's key
     std::vector<int> history;                  // its flux history (index into histories), or -1
     std::unordered_map<uint64_t, std::pair<bigint, int>> carry;
+    // Between two neighbour builds LIGGGHTS (neigh_modify every 1 delay 0 check yes) lets no atom
+    // move, or grow (Neighbor::check_distance with radvary_flag), by more than half the skin, so
+    // an atom farther from a primitive plane or cylinder than its radius plus the skin at a build
+    // cannot touch it before the next: each such wall is tested only against the atoms near it,
+    // listed at the build (and again whenever a radius changed, to rely on no bound for that).
+    // Other neighbour settings test every atom at every step.
+    std::vector<std::vector<int>> close_to;    // per plane, then per cylinder: local atoms near it
+    std::vector<double> close_radius;          // the radii when the lists were made
+    bool close_valid = false;
 
     void event(int kind, bigint step, double i, double j, double vn, const double *n, double duration,
                double Ti = NAN, double Tj = NAN, double imposed = 0.0)
@@ -342,6 +351,33 @@ struct Recorder {
         return me > last_wall;
     }
 
+    // Whether the plane and cylinder tests may visit only the atoms near each (``close_to``),
+    // making the lists at a build, at the first call, or when a radius changed since.
+    bool list_close(int nlocal, double **x, const double *r, bool rebuilt)
+    {
+        const Neighbor *nb = lmp->neighbor;
+        if (!(nb->every == 1 && nb->delay == 0 && nb->dist_check)) { close_valid = false; return false; }
+        const bool same_radii = close_valid && close_radius.size() == size_t(nlocal) &&
+                                (nlocal == 0 || std::memcmp(close_radius.data(), r, sizeof(double) * nlocal) == 0);
+        if (!rebuilt && same_radii) return true;
+        const double skin = nb->skin;
+        close_to.assign(axis.size() + cyl_axis.size(), std::vector<int>());
+        for (size_t w = 0; w < axis.size(); ++w)
+            for (int i = 0; i < nlocal; ++i)
+                if (std::fabs(x[i][axis[w]] - position[w]) < r[i] + skin) close_to[w].push_back(i);
+        for (size_t w = 0; w < cyl_axis.size(); ++w) {
+            const int a = cyl_axis[w], lo = std::min((a + 1) % 3, (a + 2) % 3), hi = std::max((a + 1) % 3, (a + 2) % 3);
+            for (int i = 0; i < nlocal; ++i) {
+                const double d1 = x[i][lo] - cyl_c1[w], d2 = x[i][hi] - cyl_c2[w];
+                if (std::fabs(std::sqrt(d1 * d1 + d2 * d2) - cyl_radius[w]) < r[i] + skin)
+                    close_to[axis.size() + w].push_back(i);
+            }
+        }
+        close_radius.assign(r, r + nlocal);
+        close_valid = true;
+        return true;
+    }
+
     void record(bigint step)
     {
         Atom *atom = lmp->atom;
@@ -426,36 +462,43 @@ struct Recorder {
                 }
             }
         }
-        for (size_t w = 0; w < axis.size(); ++w) {
+        const bool close_only = list_close(nlocal, x, r, rebuilt);
+        for (size_t w = 0; w < axis.size(); ++w, k += nlocal) {
             const int a = axis[w];
-            for (int i = 0; i < nlocal; ++i, ++k) {
+            auto test = [&](int i) {
+                const size_t kk = k + i;
                 const double gap = x[i][a] - position[w];
-                if (r[i] - std::fabs(gap) <= 0) { off(k, step, rebuilt); continue; }
-                if (touch[k] && !rebuilt) continue;
+                if (r[i] - std::fabs(gap) <= 0) { off(kk, step, rebuilt); return; }
+                if (touch[kk] && !rebuilt) return;
                 double n[3] = {0, 0, 0};
                 n[a] = gap >= 0 ? 1.0 : -1.0;                                  // from the wall to the particle
-                on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(code[w]), tag[i], code[w], i, -1,
+                on(kk, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(code[w]), tag[i], code[w], i, -1,
                    -v[i][a] * n[a], n, new_planes);
-            }
+            };
+            if (close_only) for (int i : close_to[w]) test(i);
+            else for (int i = 0; i < nlocal; ++i) test(i);
         }
         // cylinders (particles inside or outside): overlap = radius - distance to the surface,
         // the normal from the wall to the particle, as pyhost.engines.dem._primitive_contacts
-        for (size_t w = 0; w < cyl_axis.size(); ++w) {
+        for (size_t w = 0; w < cyl_axis.size(); ++w, k += nlocal) {
             const int a = cyl_axis[w], b = (a + 1) % 3, c = (a + 2) % 3;
             const int lo = std::min(b, c), hi = std::max(b, c);          // the other axes in order (c1, c2)
             const double R = cyl_radius[w];
-            for (int i = 0; i < nlocal; ++i, ++k) {
+            auto test = [&](int i) {
+                const size_t kk = k + i;
                 const double d1 = x[i][lo] - cyl_c1[w], d2 = x[i][hi] - cyl_c2[w];
                 const double dist = std::sqrt(d1 * d1 + d2 * d2);
                 const bool inside = dist < R;
-                if (r[i] - (inside ? R - dist : dist - R) <= 0) { off(k, step, rebuilt); continue; }
-                if (touch[k] && !rebuilt) continue;
+                if (r[i] - (inside ? R - dist : dist - R) <= 0) { off(kk, step, rebuilt); return; }
+                if (touch[kk] && !rebuilt) return;
                 const double s = (inside ? -1.0 : 1.0) / (dist > 0 ? dist : 1.0);
                 double n[3] = {0, 0, 0};
                 n[lo] = d1 * s; n[hi] = d2 * s;
-                on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(cyl_code[w]), tag[i], cyl_code[w],
+                on(kk, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(cyl_code[w]), tag[i], cyl_code[w],
                    i, -1, -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]), n, new_planes);
-            }
+            };
+            if (close_only) for (int i : close_to[axis.size() + w]) test(i);
+            else for (int i = 0; i < nlocal; ++i) test(i);
         }
         // mesh walls. Where LIGGGHTS keeps a contact history of the mesh (fix wall/gran with
         // tangential history) and its wall/gran fixes come before this fix (their post_force
@@ -585,6 +628,7 @@ void collheat_events_planes(void *handle, int n, const int *axis, const double *
     rec->position.assign(position, position + n);
     rec->code.assign(code, code + n);
     rec->new_planes = true;
+    rec->close_valid = false;
 }
 
 // The host's primitive cylinders: n of them, each an axis (0, 1, 2), a radius [m], the centre in
@@ -599,6 +643,7 @@ void collheat_events_cylinders(void *handle, int n, const int *axis, const doubl
         return;
     rec->cyl_axis = a; rec->cyl_radius = R; rec->cyl_c1 = x1; rec->cyl_c2 = x2; rec->cyl_code = k;
     rec->new_planes = true;
+    rec->close_valid = false;
 }
 
 // The host's mesh walls: n `fix mesh/surface` ids and the partner code of each. Returns the

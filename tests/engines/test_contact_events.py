@@ -111,6 +111,89 @@ def test_a_sphere_thrown_at_a_cylinder_wall_begins_at_its_radial_speed(tmp_path)
     assert np.allclose(begin[0]["n"], [-v[0] / speed, -v[1] / speed, 0.0], atol=1e-9)
 
 
+def test_wall_events_follow_the_geometry_step_by_step(tmp_path):
+    """200 spheres poured into a zcylinder (radius 8 mm) on a floor plane, beside an xplane: at
+    every step the particles that begin and end touching each primitive wall are exactly those
+    whose distance to it crosses their radius (LIGGGHTS' own test). Between neighbour builds
+    the recorder tests only the particles near each wall, listed at the build."""
+    Rc, floor, side = 0.008, -0.01, 0.0075
+    with box(tmp_path, dt=1e-5) as lg:
+        lg.commands(f"""
+            fix floor all wall/gran model hertz tangential history primitive type 1 zplane {floor}
+            fix side all wall/gran model hertz tangential history primitive type 1 xplane {side}
+            fix tube all wall/gran model hertz tangential history primitive type 1 zcylinder {Rc} 0 0
+            fix gravi all gravity 9.81 vector 0 0 -1
+            region fill cylinder z 0 0 0.006 -0.009 0.005 units box
+            fix pts all particletemplate/sphere 15485863 atom_type 1 density constant {RHO} radius constant {R}
+            fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+            fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0.05 0 -0.3 insert_every once overlapcheck yes all_in yes particles_in_region 200 region fill
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        ev.planes([2, 0], [floor, side], [WALL_BASE + 0, WALL_BASE + 1])
+        ev.cylinders([2], [Rc], [0.0], [0.0], [WALL_BASE + 2])
+        lg.run(1)
+        ev.take()
+
+        def touching():
+            ids, x, r = lg.atom("id").astype(int), lg.atom("x"), lg.atom("radius")
+            gaps = {0: np.abs(x[:, 2] - floor), 1: np.abs(x[:, 0] - side),
+                    2: np.abs(np.hypot(x[:, 0], x[:, 1]) - Rc)}
+            return {(int(i), WALL_BASE + w) for w, g in gaps.items() for i in ids[r - g > 0]}
+
+        before = touching()
+        begun, ended, met = 0, 0, set()
+        for _ in range(3000):
+            lg.run(1)
+            now = touching()
+            got = ev.take()
+            walls = got[got["wall"]]
+            pairs = lambda kind: {(int(e["i"]), int(e["j"])) for e in walls[walls["kind"] == kind]}
+            assert pairs(BEGIN) == now - before
+            assert pairs(END) == before - now
+            begun += len(now - before)
+            ended += len(before - now)
+            met |= {j for _, j in now - before}
+            before = now
+        print(f"{begun} wall contacts begun, {ended} ended, {len(now)} open at the end")
+        assert begun > 100 and ended > 10 and met == {WALL_BASE, WALL_BASE + 1, WALL_BASE + 2}
+
+
+def test_a_sphere_grown_into_a_plane_begins_touching_it(tmp_path):
+    """A sphere at rest 1.7 R above a plane (farther than its radius and the skin, R/2, when the
+    recorder first lists the particles near each wall), grown by fix adapt at every step until
+    it reaches the plane: the contact begins at the step the radius passes the gap. (LIGGGHTS
+    builds its lists again as the growth uses up the skin; the recorder lists the particles near
+    a wall again at every change of radius.)"""
+    gap = 1.7 * R
+    with box(tmp_path) as lg:
+        lg.commands(f"""
+            fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+            create_atoms 1 single 0 0 {gap} units box
+            set atom 1 diameter {2 * R} density {RHO}
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        ev.planes([2], [0.0], [WALL_BASE])
+        lg.run(1)
+        ev.take()
+        lg.commands(f"""
+            variable dgrow atom {2 * R}*(1+1e-4*(step-1))
+            fix grow all adapt 1 atom diameter v_dgrow
+        """)
+        steps = []
+        for _ in range(8000):
+            lg.run(1)
+            got = ev.take()
+            steps += [int(e["step"]) for e in got[got["kind"] == BEGIN]]
+            if steps:
+                break
+        r, z = float(lg.atom("radius")[0]), float(lg.atom("x")[0, 2])
+    assert len(steps) == 1, "the grown sphere's contact with the plane was not recorded"
+    print(f"begun at step {steps[0]}: radius {r / R:.5f} R, centre {z / R:.5f} R above the plane")
+    assert r > z and r - z < 2e-4 * R          # the first step in contact: the radius just past the gap
+
+
 def test_heat_gran_flux_histories_equal_liggghts_own_per_contact_flux(tmp_path):
     """With a fix heat/gran (area correction on), the recorder keeps the flux through each new
     pair contact at each of its first steps: the head-on pair's history equals, step by step,
