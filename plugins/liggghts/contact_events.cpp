@@ -356,6 +356,7 @@ struct Recorder {
     bool list_close(int nlocal, double **x, const double *r, bool rebuilt)
     {
         const Neighbor *nb = lmp->neighbor;
+        if (axis.empty() && cyl_axis.empty()) return false;
         if (!(nb->every == 1 && nb->delay == 0 && nb->dist_check)) { close_valid = false; return false; }
         const bool same_radii = close_valid && close_radius.size() == size_t(nlocal) &&
                                 (nlocal == 0 || std::memcmp(close_radius.data(), r, sizeof(double) * nlocal) == 0);
