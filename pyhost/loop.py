@@ -200,6 +200,8 @@ class Coupling:
                 checkpoint.write(self)
             self.progress.update(self.t, f", {self.totals['collisions']} collisions")
             signals.check()
+        if self.fluid_exchange is not None:     # the last advance, if it ran beside the DEM: a failure
+            self.fluid_exchange.fluid.wait()    # in it stops this run like any other (summary, exit 3)
         if self.heat or (self.collisions is not None and self.collisions.events):
             atoms = self.dem.atoms(self.heat)
             self.track_particles(atoms)

@@ -162,3 +162,42 @@ def test_fluid_beside_the_dem_gives_the_same_run(tmp_path):
         files[overlap] = [(out / f).read_bytes() for f in ("collisions.csv", "history.csv")]
         files[overlap].append(json.loads((out / "summary.json").read_text()))
     assert files["always"] == files["never"]
+
+
+def test_a_failure_of_the_last_advance_beside_the_dem_stops_the_run_with_its_summary(tmp_path):
+    """The fluid's last advance of a run, left running beside the DEM, fails (injected: the
+    solver's answer raises FluidError when the host takes it): the run stops as at any other
+    failure, FluidError raised, with summary.json saying it stopped and why."""
+    import tomllib
+
+    import tomli_w
+
+    from pyhost.engines.openfoam import FluidError
+    from pyhost.world import simulate
+
+    base = tomllib.loads((CASES / "two-particles" / "case.toml").read_text())
+    scene = dict(base, effects={"fluid": True}, fluid={"cells": [2, 1, 2], "overlap": "always"},
+                 time=dict(dem_step=2e-7, end=2e-4), output=dict(every=1e-4, pictures=False, vtk=False))
+    (tmp_path / "case").mkdir()
+    (tmp_path / "case" / "case.toml").write_text(tomli_w.dumps(scene))
+
+    class FailingAnswer:
+        """The solver, whose first answer taken by the loop's own wait is a failure."""
+        def __init__(self, fluid):
+            self.fluid, self.failed = fluid, False
+
+        def __getattr__(self, name):
+            return getattr(self.fluid, name)
+
+        def wait(self):
+            self.fluid.wait()
+            if not self.failed:
+                self.failed = True
+                raise FluidError("injected: the solver failed in its last advance")
+
+    with pytest.raises(FluidError, match="injected"):
+        simulate(load_scene(tmp_path / "case" / "case.toml"), tmp_path / "out", progress_every=1e9,
+                 wrap_fluid=FailingAnswer)
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["status"].startswith("stopped at t = ") and "FluidError" in summary["status"]
+    assert summary["time"] == pytest.approx(2e-4)
