@@ -46,6 +46,10 @@ frame, checkpoint and sample, and at a fluid exchange that reads temperatures): 
 recorder's buffer and the wait of a signal (a stop is taken between two DEM chunks)."""
 
 
+FRAME_EVERY = 1e-3
+"""s between frames where output.every is 0 and the script has no dump (box scenes: always)."""
+
+
 @dataclass(frozen=True)
 class HostWall:
     """A LIGGGHTS wall as the host sees it: its fix id (and the index of the mesh within a
@@ -105,10 +109,11 @@ class Coupling:
         self.progress = Progress(end or math.inf, progress_every)
         events = self.collisions is not None and self.collisions.events
         sampled = self.collisions is not None and self.collisions.sampled
+        self._frame_every = None
         self.every = dict(sample=scene.time.sample_every if sampled else 0,
                           harvest=(scene.time.sample_every if self.collisions.restitution else HARVEST_EVERY)
                           if events else 0,
-                          frame=max(1, round(scene.output.every / dem.dt)),
+                          frame=self.frame_every(),
                           couple=scene.time.couple_every if fluid is not None else 0,
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
         if events:                           # the walls' contacts now are open ones: one that begins at
@@ -174,6 +179,7 @@ class Coupling:
             self.balance.resync()
         self.resumed = False
         self.run_left = n
+        self.every["frame"] = self.frame_every()   # (a script's dumps and time step as they are now)
         while n > 0:
             step = self.dem.step - self.t0_step
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
@@ -207,6 +213,20 @@ class Coupling:
             self.track_particles(atoms)
             if self.collisions is not None:
                 self.collisions.end_of_run(atoms)
+
+    def frame_every(self) -> int:
+        """DEM steps between frames: output.every, or where it is 0 the interval of the
+        script's most frequent dump as defined now (frames at the steps of its dumps), else
+        FRAME_EVERY seconds. A script's run says it when it changes."""
+        every = self.scene.output.every
+        dumps = self.dem.dump_every() if every == 0 and self.scene.scripted else 0
+        n = dumps or max(1, round((every or FRAME_EVERY) / self.dem.dt))
+        if self.scene.scripted and n != self._frame_every:
+            source = ("output.every" if every else "the script's most frequent dump" if dumps
+                      else "the default: no dump in the script")
+            print(f"frames and history rows every {n} steps ({n * self.dem.dt:.4g} s; {source})")
+        self._frame_every = n
+        return n
 
     def note_before(self, atoms) -> None:
         """The particles before the next chunk (time, ids, positions, velocities, step): what

@@ -210,7 +210,9 @@ class Time:
 
 @dataclass(frozen=True)
 class Output:
-    every: float = spec(">0", 1e-3, "interval between VTK frames [s]")
+    every: float = spec(">=0", 0.0, "interval between VTK frames and history rows [s]; 0: a script's own rhythm, "
+                        "its most frequent dump at each run (frames at the steps of its dumps), else 1e-3 s "
+                        "(box scenes, scripts without dumps)")
     vtk: bool = spec(default=True, doc="write VTK time series")
     pictures: bool = spec(default=True, doc="write PNG pictures")
     checkpoint: float = spec(">=0", 0.0, "simulated time between periodic checkpoints into OUT/checkpoint [s]; "

@@ -126,7 +126,7 @@ def check_scene(scene) -> None:
         if d.periodic[face_axis(w.plane)[0]]:
             raise SceneError(f"{file}: walls[{k}].plane: {w.plane!r} lies on the periodic axis {w.plane[0]} "
                              f"(domain.periodic = {d.periodic})")
-    if scene.output.every < tm.dem_step:
+    if 0 < scene.output.every < tm.dem_step:
         raise SceneError(f"{file}: output.every: must be at least time.dem_step ({tm.dem_step:g} s), "
                          f"got {scene.output.every:g} s")
     if tm.test_end > tm.end:

@@ -17,6 +17,7 @@
 #include "fix.h"
 #include "fix_external.h"
 #include "update.h"
+#include "output.h"
 
 using namespace LAMMPS_NS;
 
@@ -230,6 +231,16 @@ double *collheat_fix_external_force(void *ptr, const char *id)
     if (i < 0 || std::strcmp(lmp->modify->fix[i]->style, "external") != 0) return nullptr;
     FixExternal *f = static_cast<FixExternal *>(lmp->modify->fix[i]);
     return f->fexternal ? f->fexternal[0] : nullptr;
+}
+
+// The interval [steps] of the script's most frequent dump with a fixed interval; 0 if none.
+int collheat_dump_every(void *ptr)
+{
+    const Output *out = static_cast<LAMMPS *>(ptr)->output;
+    int every = 0;
+    for (int i = 0; i < out->ndump; ++i)
+        if (out->every_dump[i] > 0 && (every == 0 || out->every_dump[i] < every)) every = out->every_dump[i];
+    return every;
 }
 
 }

@@ -237,6 +237,11 @@ class Dem:
     def step(self) -> int:
         return self.lmp.step
 
+    def dump_every(self) -> int:
+        """The script's most frequent dump with a fixed interval [steps] as defined now; 0 if none
+        (the same on every rank)."""
+        return self.lmp.dump_every()
+
     def box(self):
         """(lo, hi, periodic) of the simulation box [m]."""
         lo, hi = self.lmp.box()

@@ -56,6 +56,10 @@ class DemEngine(Protocol):
     def report_warnings(self, cmd=None) -> None:
         """Say the engine's new warnings once."""
 
+    def dump_every(self) -> int:
+        """The steps between the script's most frequent dump's outputs, as defined now (one with
+        a fixed interval); 0 if none. Frames follow it where output.every is 0."""
+
     def close(self) -> None:
         """End the engine."""
 

@@ -68,6 +68,7 @@ _HELPER_DECLARATIONS = {
     "collheat_move_mesh_time": (_int, [_vp, _cp, _c.POINTER(_c.c_double), _int]),
     "collheat_random_state": (_int, [_vp, _cp, _cp, _c.POINTER(_int), _int]),
     "collheat_keep_mesh_bins": (_int, [_vp]),
+    "collheat_dump_every": (_int, [_vp]),
 }
 
 # Per-atom arrays: name -> (ctype, columns; 0 for a vector).
@@ -348,6 +349,11 @@ class Liggghts:
         """Current time step number."""
         raw = self.lib.lammps_extract_global(self.ptr, b"ntimestep")
         return ctypes.cast(raw, ctypes.POINTER(ctypes.c_int64))[0]
+
+    def dump_every(self) -> int:
+        """The interval [steps] of the most frequent dump defined now with a fixed interval
+        (a dump whose interval is a variable is left out); 0 if there is none."""
+        return self.helper.collheat_dump_every(self.ptr)
 
     @property
     def dt(self) -> float:

@@ -62,6 +62,12 @@ def test_debian_heat_transfer_tutorial_runs_unchanged(tmp_path):
     steps = sorted(frames)
     assert steps[-1] == 20800 and all(b - a == 800 for a, b in zip(steps[1:], steps[2:]))
     assert len(frames[20800]) == 890 and frames[20800].time == pytest.approx(0.52)
+    # without [output] every, the host's frames (history rows) come at the steps of the
+    # script's own dump, once it is defined (after the script's 'run 1'), and said so
+    with open(case / "out" / "history.csv") as f:
+        history = [round(float(row["time"]) / 2.5e-5) for row in csv.DictReader(f)]
+    assert history == [0] + steps, (history[:5], steps[:5])
+    assert "frames and history rows every 800 steps (0.02 s; the script's most frequent dump)" in r.stdout
     frame = frames[20000]
     T, x = frame["f_Temp[0]"], frame.positions()[:, 0]
     m_c = 8000 * 4 / 3 * math.pi * 0.004**3 * 10.0           # J/K per sphere
