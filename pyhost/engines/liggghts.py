@@ -22,6 +22,7 @@ from __future__ import annotations
 import atexit
 import ctypes
 import os
+import select
 import signal
 import tempfile
 import time
@@ -316,22 +317,42 @@ class Liggghts:
 
     @staticmethod
     def _wait_trial(pid: int, trial: Path) -> int:
-        """Wait for the copy. One that wrote an ERROR line and still lives a second later is
-        stuck in MPI_Finalize (MPI started by another LIGGGHTS user of this process, without
-        the isolated singleton): end it."""
-        errored_at, pause, start = None, 1e-4, time.monotonic()
-        while True:
+        """Wait for the copy: woken the moment it ends (a pidfd; where the kernel has none,
+        by polling). One that wrote an ERROR line and still lives a second later is stuck in
+        MPI_Finalize (MPI started by another LIGGGHTS user of this process, without the
+        isolated singleton): end it."""
+        errored_at, start, status = None, time.monotonic(), None
+        try:
+            fd = os.pidfd_open(pid)
+        except OSError:
+            fd = None
+        poller = select.poll()
+        if fd is not None:
+            poller.register(fd, select.POLLIN)
+
+        def ended() -> bool:                      # within 20 ms (or 2 ms, polling), or now
+            nonlocal status
+            if fd is not None:
+                return bool(poller.poll(20))
             done, status = os.waitpid(pid, os.WNOHANG)
-            if done:
-                return status
-            if (errored_at is None and time.monotonic() - start > 0.5 and trial.exists()
-                    and "\nERROR" in "\n" + trial.read_text(errors="replace")):
-                errored_at = time.monotonic()
-            if errored_at is not None and time.monotonic() - errored_at > 1.0:
-                os.kill(pid, signal.SIGKILL)
-                return os.waitpid(pid, 0)[1]
-            time.sleep(pause)
-            pause = min(2 * pause, 0.005)     # (a 50 ms cap overslept up to twice a short trial)
+            if not done:
+                status = None
+                time.sleep(0.002)
+            return bool(done)
+
+        try:
+            while not ended():
+                now = time.monotonic()
+                if (errored_at is None and now - start > 0.5 and trial.exists()
+                        and "\nERROR" in "\n" + trial.read_text(errors="replace")):
+                    errored_at = now
+                if errored_at is not None and now - errored_at > 1.0:
+                    os.kill(pid, signal.SIGKILL)
+                    break
+            return status if status is not None else os.waitpid(pid, 0)[1]
+        finally:
+            if fd is not None:
+                os.close(fd)
 
     # -- per-atom data ----------------------------------------------------------------
     @property
