@@ -198,12 +198,13 @@ class Time:
                                   "the fluid case's controlDict endTime)")
     contacts: str = spec("in:events,samples", "events",
                          "how collisions are found: 'events', recorded inside LIGGGHTS at every step (the "
-                         "impact speed as it is at first touch, no collision missed; serial runs without "
-                         "restitution feedback, else samples are used), or 'samples' of LIGGGHTS' contact "
-                         "lists every sample_every steps")
+                         "impact speed as it is at first touch, no collision missed; on every rank under MPI; "
+                         "a mesh wall without a fix wall/gran of its own is sampled beside them), or "
+                         "'samples' of LIGGGHTS' contact lists every sample_every steps (the reference the "
+                         "events were checked against; docs/contact-events.md)")
     sample_every: int = spec(">0", 1, "DEM steps between contact samples (with contact events: of the mesh "
-                                      "walls the recorder cannot take only; 10 misses 6 % of chute_wear's wall "
-                                      "contacts)")
+                                      "walls the recorder cannot take only, 10 missing 6 % of chute_wear's wall "
+                                      "contacts; and, with restitution feedback, between harvests)")
     couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
 
