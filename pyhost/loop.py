@@ -287,6 +287,8 @@ class Coupling:
             if status == "completed":
                 raise
             print(f"warning: the collisions since the last harvest are not in the log ({type(err).__name__}: {err})")
+        if status == "completed" and self.frames.last_step != self.dem.step:
+            self.write_frame()                # the end's state in history.csv and the VTK series
         for effect in self.effect_list:      # (the fluid: its last advance, if it runs beside the DEM)
             try:
                 effect.flush()

@@ -1,6 +1,8 @@
 """The frames: one row of history.csv and one VTK frame of the particles every output.every
-seconds. The row's first columns are the particles' (count, temperatures, heat content) and
-the run's totals; each other effect adds its own columns after them (``Effect.columns``)."""
+seconds (for a script, by default, at the steps of its most frequent dump), and one at the end
+of a completed run that did not end on one (``Coupling.finish``). The row's first columns are
+the particles' (count, temperatures, heat content) and the run's totals; each other effect
+adds its own columns after them (``Effect.columns``)."""
 from __future__ import annotations
 
 import math
@@ -29,9 +31,11 @@ class Frames(Effect):
                         + sum((e.columns for e in others), ()))
         self.history = CsvLog(loop.out / "history.csv", self.columns, logs.get("history"))
         self.particles = VtkSeries(loop.out / "vtk", "particles", logs.get("particles")) if loop.scene.output.vtk else None
+        self.last_step = None           # the step of the last frame
 
     def frame(self) -> None:
         loop = self.loop
+        self.last_step = loop.dem.step
         heat = loop.heat
         atoms = loop.dem.atoms(heat)
         T = atoms.T if heat else np.full(len(atoms.id), np.nan)
@@ -56,7 +60,11 @@ class Frames(Effect):
 
     def state(self) -> tuple[dict, dict]:
         return dict(logs=dict(history=self.history.mark(),
-                              particles=self.particles.frames if self.particles is not None else None)), {}
+                              particles=self.particles.frames if self.particles is not None else None),
+                    frame_step=self.last_step), {}
+
+    def restore(self, state: dict) -> None:
+        self.last_step = state.get("frame_step")
 
     def close(self) -> None:
         self.history.close()

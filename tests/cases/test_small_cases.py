@@ -79,6 +79,24 @@ def test_hot_cold_box_smoke_conserves_and_converges(tmp_path):
     assert (tmp_path / "particles.png").stat().st_size > 10000
 
 
+def test_a_run_that_does_not_end_on_a_frame_gets_one_at_its_end(tmp_path):
+    """two-particles for 1.5 ms with frames every 0.4 ms: rows at 0, 0.4, 0.8 and 1.2 ms, and
+    one at the end, holding the state summary.json reports (the same totals)."""
+    text = (CASES / "two-particles" / "case.toml").read_text()
+    assert "every = 2e-4" in text and "end = 2e-3 " in text
+    (tmp_path / "case.toml").write_text(text.replace("every = 2e-4", "every = 4e-4").replace("end = 2e-3 ", "end = 1.5e-3 "))
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    hist = list(csv.DictReader(open(out / "history.csv")))
+    summary = json.loads((out / "summary.json").read_text())
+    assert [float(h["time"]) for h in hist] == pytest.approx([0.0, 4e-4, 8e-4, 1.2e-3, 1.5e-3], abs=1e-9)
+    assert float(hist[-1]["time"]) == pytest.approx(summary["time"], abs=1e-12)
+    assert int(hist[-1]["collisions"]) == summary["collisions"] == 1
+    assert pyvista.get_reader(str(out / "vtk" / "particles.pvd")).time_values[-1] == pytest.approx(1.5e-3, abs=1e-9)
+
+
 def test_particle_outside_the_box_is_refused_before_liggghts(tmp_path):
     text = (CASES / "two-particles" / "case.toml").read_text()
     (tmp_path / "case.toml").write_text(text.replace("[[0.045, 0.005, 0.01]]", "[[0.5, 0.005, 0.01]]"))
