@@ -117,6 +117,12 @@ class Dem:
         self.info.learn(cmd)
         self.report_warnings(cmd)
 
+    def try_ahead(self, cmds: list[Command]) -> None:
+        """The script's next commands tried together in one forked copy (a serial run; each
+        is otherwise tried alone): see ``Liggghts.try_ahead``."""
+        if self.link is None:
+            self.lmp.try_ahead([c.text for c in cmds])
+
     def _before(self, cmd: Command) -> None:
         """What the host added that a valid script command would trip on: LIGGGHTS refuses
         to unfix a mesh wall while a compute wall/gran/local is active, so the host's goes

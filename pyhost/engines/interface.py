@@ -39,6 +39,10 @@ class DemEngine(Protocol):
     def command(self, cmd) -> None:
         """Run one script command (not a ``run``)."""
 
+    def try_ahead(self, cmds) -> None:
+        """The next script commands (up to the next ``run``), which will come in this order:
+        an engine that checks each command before running it may check them together now."""
+
     def engine_command(self, line: str) -> None:
         """Run a command of the host's own (write_restart, ...)."""
 

@@ -157,6 +157,17 @@ def test_a_zero_time_step_is_refused(tmp_path):
     assert "the time step is 0 s" in r.stderr
 
 
+def test_a_command_liggghts_refuses_mid_script_is_named_with_its_line(tmp_path):
+    """The set-up's commands are tried together in one forked copy: a bad one in the middle
+    (line 17 of the 25 before the run) still stops the run with exit 2, naming its file, line
+    and LIGGGHTS' own message."""
+    script = header().replace("pair_coeff * *\n", "pair_coeff * *\nfix bad all bogus 1 2 3\n") + "run 100\n"
+    assert script.splitlines()[16] == "fix bad all bogus 1 2 3" and len(script.splitlines()) == 26
+    r, _ = run(tmp_path, script, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "in.run:17" in r.stderr and 'Invalid fix style: "bogus"' in r.stderr, r.stderr[-2000:]
+
+
 def test_smoke_run_cuts_the_first_run(tmp_path):
     """--test with time.test_end = 1 ms stops the script's first (and only) run of 50,000
     steps after 100 (it used to cut only the runs after the first)."""

@@ -154,6 +154,36 @@ def test_bad_command_raises_with_liggghts_message_and_host_survives(tmp_path):
         assert lg.step == 10
 
 
+def test_commands_tried_together_fork_once_and_a_bad_one_still_reports_its_own_error(tmp_path, monkeypatch):
+    """try_ahead tries a block of commands in one forked copy: the commands that passed there
+    run without a fork of their own; the first that failed is tried alone when it comes, and
+    raises LIGGGHTS' own message; the instance still runs."""
+    import os
+    forks = []
+    real_fork = os.fork
+    monkeypatch.setattr(os, "fork", lambda: forks.append(1) or real_fork())
+    with two_spheres(tmp_path) as lg:
+        good = ["variable a equal 1.0", "variable b equal v_a*2", "fix g all gravity 9.81 vector 0 0 -1"]
+        forks.clear()
+        lg.try_ahead(good)
+        for line in good:
+            lg.command(line)
+        assert len(forks) == 1                     # one copy for the three
+        block = ["variable c equal 3.0", "fix f1 all bogus 1 2 3", "variable d equal 4.0"]
+        forks.clear()
+        lg.try_ahead(block)
+        lg.command(block[0])                       # passed in the copy: no fork of its own
+        assert len(forks) == 1
+        with pytest.raises(LiggghtsError, match='Invalid fix style: "bogus"'):
+            lg.command(block[1])                   # tried alone: LIGGGHTS' message
+        assert len(forks) == 2
+        lg.command(block[2])                       # after the failure, each alone again
+        assert len(forks) == 3
+        assert lg.variable("b") == 2.0 and lg.variable("d") == 4.0
+        lg.run(10)
+        assert lg.step == 10
+
+
 def test_error_in_a_later_chunk_returns_with_liggghts_message(tmp_path):
     """Chunks after the first are not tried in a forked copy: LIGGGHTS' error (here Error::one
     of a 'fix print' reaching an undefined variable at step 20) returns from the run as
