@@ -109,13 +109,13 @@ class Coupling:
         self.progress = Progress(end or math.inf, progress_every)
         events = self.collisions is not None and self.collisions.events
         sampled = self.collisions is not None and self.collisions.sampled
-        self._frame_every = None
         self.every = dict(sample=scene.time.sample_every if sampled else 0,
                           harvest=(scene.time.sample_every if self.collisions.restitution else HARVEST_EVERY)
                           if events else 0,
-                          frame=self.frame_every(),
+                          frame=0,                    # (set just below, and at each run of a script)
                           couple=scene.time.couple_every if fluid is not None else 0,
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
+        self.every["frame"] = self.frame_every()
         if events:                           # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
         self.command, self.run_left = -1, 0  # the script's run under way (its index) and its steps to go
@@ -217,15 +217,14 @@ class Coupling:
     def frame_every(self) -> int:
         """DEM steps between frames: output.every, or where it is 0 the interval of the
         script's most frequent dump as defined now (frames at the steps of its dumps), else
-        FRAME_EVERY seconds. A script's run says it when it changes."""
+        FRAME_EVERY seconds. A script's run says it when it differs from ``every["frame"]``."""
         every = self.scene.output.every
         dumps = self.dem.dump_every() if every == 0 and self.scene.scripted else 0
         n = dumps or max(1, round((every or FRAME_EVERY) / self.dem.dt))
-        if self.scene.scripted and n != self._frame_every:
+        if self.scene.scripted and n != self.every["frame"]:
             source = ("output.every" if every else "the script's most frequent dump" if dumps
                       else "the default: no dump in the script")
             print(f"frames and history rows every {n} steps ({n * self.dem.dt:.4g} s; {source})")
-        self._frame_every = n
         return n
 
     def note_before(self, atoms) -> None:
