@@ -15,11 +15,29 @@ from pyhost.output import (ColumnLog, CsvLog, Progress, VtkSeries, collision_kin
 
 
 def test_csv_rows_are_on_disk_before_close(tmp_path):
+    """Rows go to disk by the output thread: once the log's size is asked (a checkpoint's mark),
+    they are there, flushed, before the log is closed."""
     log = CsvLog(tmp_path / "c.csv", ("time", "i", "Q"))
     log.write_columns(time=np.array([0.1, 0.2]), i=np.array([3, 4]), Q=np.array([1e-6, 2e-6]))
+    assert log.size == (tmp_path / "c.csv").stat().st_size
     text = (tmp_path / "c.csv").read_text().splitlines()      # not closed yet
     assert text == ["time,i,Q", "0.1,3,1e-06", "0.2,4,2e-06"]
     log.close()
+
+
+def test_csv_rows_are_written_from_copies_in_order(tmp_path):
+    """The output thread writes the columns as they were when given, in the order given, in
+    chunks of CHUNK rows: the caller may change its arrays at once (the next batch)."""
+    log = CsvLog(tmp_path / "c.csv", ("i", "Q"))
+    n = 2 * CsvLog.CHUNK + 7
+    ids, Q = np.arange(n), np.linspace(0.0, 1.0, n)
+    log.write_columns(i=ids, Q=Q)
+    ids[:] = -1
+    Q[:] = np.nan
+    log.write([(n, 2.0)])
+    log.close()
+    rows = (tmp_path / "c.csv").read_text().splitlines()[1:]
+    assert rows == [f"{k},{q!r}" for k, q in zip(range(n), np.linspace(0.0, 1.0, n).tolist())] + [f"{n},2.0"]
 
 
 def test_vtk_series_readable_after_each_frame(tmp_path):
@@ -164,12 +182,16 @@ def test_a_full_disk_names_the_log_it_was_writing(tmp_path):
         def flush(self):
             pass
 
+        def close(self):
+            pass
+
     log = CsvLog(tmp_path / "collisions.csv", ("time", "i"))
     log._file.close()
     log._file = Full()
     log._csv = csv.writer(log._file)
-    with pytest.raises(OSError) as err:
-        log.write([(0.5, 1)])
+    log.write([(0.5, 1)])                       # written by the output thread: its error comes
+    with pytest.raises(OSError) as err:         # with the next call that waits for it
+        log.close()
     code, message = classify(err.value)
     assert code == 2 and message == f"{tmp_path / 'collisions.csv'}: No space left on device"
 
