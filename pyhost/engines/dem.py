@@ -183,7 +183,7 @@ class Dem:
         contact event recorder in place of the pair compute), and the fluid force.
         ``contacts``: whether the loop samples contacts (default: with heat). Returns the
         added commands (printed once)."""
-        from pyhost.engines.events import FIX as EVENTS_FIX
+        from pyhost.engines.events import fix_command
 
         contacts = heat if contacts is None else contacts
         events = events and contacts
@@ -191,7 +191,7 @@ class Dem:
         if heat and not self.info.temp_fix and not self.info.heat_gran:
             added.append("fix Temp all property/atom Temp scalar yes yes no 0.0")
         if events:
-            added.append(f"fix {EVENTS_FIX} all external pf/callback 1 1")
+            added.append(fix_command())
         if contacts and not events and self.info.pair_compute is None:
             keys = "pos vel id delta" + (" heatFlux" if self.info.heat_gran else "")
             added.append(f"compute {PAIR_COMPUTE} all pair/gran/local {keys}")

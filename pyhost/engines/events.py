@@ -1,6 +1,6 @@
 """Contact events recorded inside LIGGGHTS at every DEM step (``plugins/liggghts/contact_events.cpp``).
 
-``ContactEvents(lmp)`` adds ``fix collheat_events all external pf/callback 1 1`` and attaches
+``ContactEvents(lmp)`` adds ``fix collheat_events all external pf/callback 1 APPLY`` and attaches
 the helper's recorder to it: from the next run on, every step (in compiled code, no Python)
 notes each particle-particle contact and each contact with the host's primitive planes that
 begins or ends. ``take()`` hands the events over in a batch, as a numpy structured array of
@@ -30,6 +30,14 @@ import numpy as np
 from pyhost.engines.collective import collective
 
 FIX = "collheat_events"
+APPLY = 1 << 30
+"""The fix's napply: LIGGGHTS adds its (zeroed) force array only at steps that are multiples
+of it, not at every step (plugins/liggghts/contact_events.cpp keeps the same number)."""
+
+
+def fix_command(fix: str = FIX) -> str:
+    """The LIGGGHTS command that adds the recorder's fix: its callback at every step."""
+    return f"fix {fix} all external pf/callback 1 {APPLY}"
 RECORDED = frozenset({"xplane", "yplane", "zplane", "xcylinder", "ycylinder", "zcylinder"})
 """The primitive wall kinds (``pyhost.walls.PRIMITIVES``) whose contacts the recorder notes
 (``planes``, ``cylinders``; plugins/liggghts/contact_events.cpp). A kind of pyhost.walls that
@@ -77,7 +85,7 @@ class ContactEvents:
         for name, (restype, argtypes) in _DECLARATIONS.items():
             fn = getattr(h, name)
             fn.restype, fn.argtypes = restype, argtypes
-        lmp.command(f"fix {fix} all external pf/callback 1 1")
+        lmp.command(fix_command(fix))
         self.handle = h.collheat_events_attach(lmp.ptr, fix.encode())
         if not self.handle:
             raise RuntimeError(f"could not attach the contact event recorder to fix {fix}")

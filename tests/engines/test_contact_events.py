@@ -394,3 +394,32 @@ def test_a_moving_mesh_meets_a_particle_at_its_own_speed(tmp_path):
     print(f"begin at step {begin[0]['step']}, vn {begin[0]['vn']:.12f} m/s")
     assert begin[0]["vn"] == pytest.approx(V, rel=1e-9)
     assert np.allclose(begin[0]["n"], [0, 0, 1], atol=1e-9)
+
+
+def test_the_recorder_adds_no_force_to_a_pour_with_insertions(tmp_path):
+    """Spheres inserted every 400 steps into a box and settling: with the recorder's fix (which
+    LIGGGHTS adds to the forces only at multiples of its napply, zeroed by the callback there)
+    every position and velocity after 8,000 steps equals, bit for bit, the run without it, the
+    inserted atoms' new slots of its array included."""
+    def pour(folder, record: bool):
+        with box(folder, lo=(0, 0, 0), hi=(0.02, 0.02, 0.04), dt=1e-5) as lg:
+            lg.commands("""
+                fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+                fix gravi all gravity 9.81 vector 0 0 -1
+                region fill block 0.001 0.019 0.001 0.019 0.03 0.039 units box
+                fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
+                fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+                fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 -1.0 insert_every 400 overlapcheck yes all_in yes particles_in_region 40 region fill
+                fix integrate all nve/sphere
+            """)
+            ev = ContactEvents(lg) if record else None
+            lg.run(8000)
+            got = ev.take() if record else None
+            order = np.argsort(lg.atom("id"))
+            return lg.atom("x")[order].copy(), lg.atom("v")[order].copy(), got
+
+    x, v, got = pour(tmp_path / "with", True)
+    x0, v0, _ = pour(tmp_path / "without", False)
+    print(f"{len(x)} atoms, {int(np.sum(got['kind'] == BEGIN))} contacts begun")
+    assert len(x) > 200 and np.sum(got["kind"] == BEGIN) > 1000
+    assert np.array_equal(x, x0) and np.array_equal(v, v0)
