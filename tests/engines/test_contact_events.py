@@ -229,20 +229,28 @@ def test_heat_gran_flux_histories_equal_liggghts_own_per_contact_flux(tmp_path):
     assert np.allclose(history[0], flux[:window], rtol=1e-12, atol=0)
 
 
+def pile(folder, bottom: float, vz: float, every, count: int) -> Liggghts:
+    """A 2 x 2 x 4 cm box with a floor and gravity, spheres of radius 1 mm inserted at ``vz``
+    [m/s] into the region from ``bottom`` [m] to the top, ``count`` at a time ``every`` steps
+    (or "once"); LIGGGHTS open, nothing run."""
+    lg = box(folder, lo=(0, 0, 0), hi=(0.02, 0.02, 0.04), dt=1e-5)
+    lg.commands(f"""
+        fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+        fix gravi all gravity 9.81 vector 0 0 -1
+        region fill block 0.001 0.019 0.001 0.019 {bottom} 0.039 units box
+        fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
+        fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+        fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 {vz} insert_every {every} overlapcheck yes all_in yes particles_in_region {count} region fill
+        fix integrate all nve/sphere
+    """)
+    return lg
+
+
 def test_events_follow_liggghts_own_contact_list_step_by_step(tmp_path):
     """A pile of 200 spheres settling: at every step, the pairs begun are exactly the pairs
     that compute pair/gran/local lists now and did not list on the step before, and the ended
     ones those it no longer lists."""
-    with box(tmp_path, lo=(0, 0, 0), hi=(0.02, 0.02, 0.04), dt=1e-5) as lg:
-        lg.commands("""
-            fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
-            fix gravi all gravity 9.81 vector 0 0 -1
-            region fill block 0.001 0.019 0.001 0.019 0.001 0.039 units box
-            fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
-            fix pdd all particledistribution/discrete 15485867 1 pts 1.0
-            fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 -0.3 insert_every once overlapcheck yes all_in yes particles_in_region 200 region fill
-            fix integrate all nve/sphere
-        """)
+    with pile(tmp_path, 0.001, -0.3, "once", 200) as lg:
         lg.add_pair_contacts()
         ev = ContactEvents(lg)
         lg.run(1)
@@ -402,16 +410,7 @@ def test_the_recorder_adds_no_force_to_a_pour_with_insertions(tmp_path):
     every position and velocity after 8,000 steps equals, bit for bit, the run without it, the
     inserted atoms' new slots of its array included."""
     def pour(folder, record: bool):
-        with box(folder, lo=(0, 0, 0), hi=(0.02, 0.02, 0.04), dt=1e-5) as lg:
-            lg.commands("""
-                fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
-                fix gravi all gravity 9.81 vector 0 0 -1
-                region fill block 0.001 0.019 0.001 0.019 0.03 0.039 units box
-                fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
-                fix pdd all particledistribution/discrete 15485867 1 pts 1.0
-                fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 -1.0 insert_every 400 overlapcheck yes all_in yes particles_in_region 40 region fill
-                fix integrate all nve/sphere
-            """)
+        with pile(folder, 0.03, -1.0, 400, 40) as lg:
             ev = ContactEvents(lg) if record else None
             lg.run(8000)
             got = ev.take() if record else None
