@@ -23,6 +23,11 @@ from pyhost.walls import FACES
 STEPS_PER_COLLISION = 10        # fewer DEM steps than this per collision: under-resolved
 
 
+class InvariantBroken(SimulationFailed):
+    """A completed run whose own check failed at its end (an effect's ``failure``: the energy
+    balance beyond round-off): its files and summary.json are written, then exit code 3."""
+
+
 class ParticlesLost(SimulationFailed):
     """Particles left the DEM's box. ``ids`` (1-based), ``position`` [m] and ``velocity``
     [m/s] where first lost one was last seen, ``time`` [s] of that sight, ``cause`` in words."""

@@ -35,7 +35,7 @@ from pyhost.effects.fluid import FluidExchange
 from pyhost.effects.frames import Frames
 from pyhost.engines.dem import Dem
 from pyhost.engines.liggghts import LiggghtsError
-from pyhost.failures import particles_lost
+from pyhost.failures import InvariantBroken, particles_lost
 from pyhost.outdir import write_atomic
 from pyhost.output import Progress
 from pyhost.script import ScriptError, parse_run, replay
@@ -303,6 +303,9 @@ class Coupling:
         write_atomic(self.out / "summary.json", json.dumps(summary, indent=1))
         for effect in self.effect_list:
             effect.close()
+        broken = [e.failure for e in self.effect_list if e.failure]
+        if broken:                            # (the results are on disk: now exit 3, no exit 0)
+            raise InvariantBroken("; ".join(broken))
         return summary
 
 

@@ -16,7 +16,9 @@ Hooks, called by the loop on every effect in the list's order (the defaults do n
     frame()        its files at a frame
     state()        (JSON values, arrays) for a checkpoint; restore(state) takes them back
     flush()        its files whole on disk (a checkpoint, the end)
-    finish(summary, status)   its part of summary.json
+    finish(summary, status)   its part of summary.json; an invariant found broken at the end
+                   of a completed run goes in ``failure`` (the run then fails, exit 3, after
+                   its summary is written and its files closed)
     close()        its files closed (after the summary)
 """
 from __future__ import annotations
@@ -28,6 +30,7 @@ class Effect:
     """One thing the loop does; ``loop`` is the ``pyhost.loop.Coupling`` that runs it."""
 
     columns: tuple = ()
+    failure: str | None = None        # what its finish found broken (a completed run only)
 
     def __init__(self, loop):
         self.loop = loop

@@ -219,3 +219,43 @@ def test_a_failure_of_the_last_advance_beside_the_dem_stops_the_run_with_its_sum
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["status"].startswith("stopped at t = ") and "FluidError" in summary["status"]
     assert summary["time"] == pytest.approx(2e-4)
+
+
+class Heating:
+    """A DEM in which particle 0 gains 1 K after every chunk behind the host's back, as a heat
+    source of a script that the host does not know would."""
+
+    def __init__(self, dem):
+        self.dem = dem
+
+    def run(self, n):
+        self.dem.run(n)
+        self.dem.lmp.temperature()[0] += 1.0
+
+    def __getattr__(self, name):
+        return getattr(self.dem, name)
+
+
+def test_a_broken_energy_balance_fails_the_run_after_writing_its_results(tmp_path):
+    """No exit 0 with a wrong answer: a completed run whose energy balance is off by more than
+    round-off raises InvariantBroken (exit 3) naming the balance, after summary.json (status
+    failed, the residual), collisions.csv and history.csv are written whole. The same run
+    without the heating passes with its balance at round-off."""
+    from pyhost.effects.balance import TOLERANCE
+    from pyhost.exitcodes import classify
+    from pyhost.failures import InvariantBroken
+    from pyhost.world import simulate
+
+    scene = load_scene(CASES / "two-particles" / "case.toml")
+    with pytest.raises(InvariantBroken, match="energy balance broken") as err:
+        simulate(scene, tmp_path / "heated", progress_every=1e9, wrap=Heating)
+    summary = json.loads((tmp_path / "heated" / "summary.json").read_text())
+    assert summary["status"].startswith("failed at the end: energy balance broken")
+    assert abs(summary["energy_balance_error"]) > 1e3 * TOLERANCE
+    assert f"{summary['energy_balance_error']:.3g}" in str(err.value)
+    assert classify(err.value)[0] == 3
+    rows = list(csv.DictReader(open(tmp_path / "heated" / "collisions.csv")))
+    assert len(rows) == summary["collisions"] == 1
+    assert list(csv.DictReader(open(tmp_path / "heated" / "history.csv")))
+    clean = simulate(scene, tmp_path / "clean", progress_every=1e9)
+    assert clean["status"] == "completed" and abs(clean["energy_balance_error"]) < 1e-12
