@@ -172,6 +172,25 @@ def test_serial_and_two_ranks_agree(tmp_path):
     assert np.abs(f1 - f2).max() <= 1e-6 * np.abs(f1).max()
 
 
+@pytest.mark.parametrize("nprocs", [1, 2])
+def test_locate_finds_the_cell_of_every_point_whatever_their_order_and_number(tmp_path, nprocs):
+    """LOCATE guesses each point's cell (its cell at the request before, then the cell of the
+    point before it) and tests the guess, else OpenFOAM's tree search: in a first request (no
+    guesses), the same points shuffled (every guess stale), points added and removed (an
+    insertion, a deletion), each point gets the cell that holds it (its centre within half a
+    cell on each axis), serially and on two fluid ranks."""
+    rng = np.random.default_rng(7)
+    lo, hi = np.array([0.0, 0.0, 0.0]), np.array([0.04, 0.01, 0.04])
+    half = (hi - lo) / np.array([16, 1, 16]) / 2                    # lid_box's cells
+    inside = lambda n: rng.uniform(lo + 1e-4, hi - 1e-4, (n, 3))
+    x = inside(500)
+    x = x[np.argsort(x[:, 2])]                                      # in space, as LIGGGHTS keeps atoms
+    with FluidSolver(lid_box(tmp_path / "case", nprocs), nprocs=nprocs) as fluid:
+        for pts in (x, x[rng.permutation(len(x))], np.r_[x[100:], inside(300)], x[:50], x):
+            cell = fluid.locate(pts)[0]
+            assert np.all(np.abs(pts - fluid.cell_centres[cell]) <= half * (1 + 1e-9))
+
+
 def test_a_rank_without_particles_does_not_hang_the_others(tmp_path):
     """The lid box split in z (1 x 1 x 2) with every particle in the lower part: the upper rank
     finds none (it used to leave the lower one waiting at the first locate for the tet base
