@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from pyhost.collisions import WALL_BASE
 from pyhost.walls import face_overlap, primitive_overlap
@@ -71,6 +70,8 @@ class ContactFinder:
         return d - np.where(self.per, self.size * np.round(d / self.size), 0.0)
 
     def _rebuild(self, x) -> None:
+        from scipy.spatial import cKDTree   # here: only sampled contacts need it (0.1-0.3 s to import)
+
         cutoff = 2.0 * self.r.max() + self.skin
         if self.per.any():
             # cKDTree wraps every axis of boxsize: non-periodic axes get a box 4x the domain,

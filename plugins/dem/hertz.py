@@ -14,11 +14,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import beta as beta_fn
 
-K_HERTZ = 0.4 * beta_fn(0.4, 0.5)
-"""int_0^1 (1 - y^(5/2))^(-1/2) dy = 1.4716...: the Hertz half-collision time in units of
-delta_max / v0 (the 1.472 of eqs. 23 and 29)."""
+K_HERTZ = 1.4716375921623523
+"""int_0^1 (1 - y^(5/2))^(-1/2) dy = 0.4 B(0.4, 0.5) = 1.4716...: the Hertz half-collision time
+in units of delta_max / v0 (the 1.472 of eqs. 23 and 29). Written out, so that a run need not
+import scipy.special (0.2 s); tests/unit/test_fast.py checks it against scipy's beta, digit
+for digit."""
 
 
 def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:

@@ -19,7 +19,6 @@ from functools import lru_cache
 
 import numpy as np
 from numpy.polynomial import Chebyshev
-from scipy.special import betainc, betaincc
 
 from plugins.dem.hertz import K_HERTZ  # noqa: F401  (re-exported: the 1.472 of eqs. 23 and 29)
 
@@ -28,6 +27,8 @@ def hertz_time_from_top(w, x_top, t_half, y=None):
     """Time [t_y] for a Hertz contact to go from indentation y = x_top - w up to its turning
     point x_top, given the half-collision time t_half. Accurate for w -> 0 (no cancellation);
     pass y as well where it is known more precisely than x_top - w."""
+    from scipy.special import betainc, betaincc   # here: only the exact path and table builds need them
+
     w = np.minimum(np.asarray(w, float), x_top)
     y = x_top - w if y is None else np.asarray(y, float)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -177,6 +178,7 @@ class Stronge:
             return (lambda w, y=None: hertz_time_from_top(w, x_top, t_half, y)), t_half
 
         def t_elastic(x):                  # time from contact to x <= 1, eq. (4)
+            from scipy.special import betainc
             return t_half * betainc(0.4, 0.5, (np.asarray(x) / x_star) ** 2.5)
 
         inv_speed = lambda w, y: 1.0 / np.sqrt(2.5 * self.work_drop(x_top, w, y))

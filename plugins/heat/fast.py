@@ -20,7 +20,6 @@ import math
 from functools import lru_cache
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from plugins.heat import exact, table_cache
 from plugins.heat.compression import compression_law
@@ -60,6 +59,8 @@ class Table:
             n = math.ceil((self.u_max - self.u_min) / h)
             segments = [self.u_min + np.arange(0, n + 1) * h]
         self.h, self.q0 = h, segments[0][0]
+        from scipy.interpolate import CubicSpline   # here: only a table's build needs it (0.2 s to import)
+
         coefs = []
         for q in segments:
             values = np.array([self._node(float(v)) for v in np.exp(self.u_of_q(q))])
