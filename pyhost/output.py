@@ -115,16 +115,14 @@ class CsvLog:
     def write(self, rows) -> None:
         """Rows (sequences of values), appended and flushed by the output thread; ``rows`` must
         not change afterwards."""
-        self._wait()
-        self._pending = _output_writer().submit(self._write_now, rows)
+        self._submit(rows)
 
     def write_columns(self, **arrays) -> None:
         """Rows from equal-length arrays named by the columns (copied: the caller may change
         its arrays)."""
         cols = [np.array(arrays[c]) for c in self.columns]
         if cols and len(cols[0]):
-            self._wait()
-            self._pending = _output_writer().submit(self._write_now, cols, True)
+            self._submit(cols, True)
 
     CHUNK = 2000            # rows per writerows call: the caller's thread gets the GIL between two
 
@@ -136,6 +134,10 @@ class CsvLog:
             else:
                 self._csv.writerows(rows)
             self._file.flush()
+
+    def _submit(self, rows, columns: bool = False) -> None:
+        self._wait()
+        self._pending = _output_writer().submit(self._write_now, rows, columns)
 
     def _wait(self) -> None:
         pending, self._pending = self._pending, None

@@ -17,7 +17,8 @@ from pyhost.script import ScriptError
 
 TOLERANCE = 1e-9
 """Largest |energy_balance_error| of a completed run (relative to all that came in); round-off
-gives 1e-16 to 1e-13 on every case and tutorial of the corpus (docs/tutorials.md)."""
+gives at most 4e-16 on the tutorials of the corpus (tools/corpus.py, docs/tutorials.md) and
+below 1e-12 on every case the tests run."""
 
 
 class EnergyBalance(Effect):

@@ -38,6 +38,8 @@ of it, not at every step (plugins/liggghts/contact_events.cpp keeps the same num
 def fix_command(fix: str = FIX) -> str:
     """The LIGGGHTS command that adds the recorder's fix: its callback at every step."""
     return f"fix {fix} all external pf/callback 1 {APPLY}"
+
+
 RECORDED = frozenset({"xplane", "yplane", "zplane", "xcylinder", "ycylinder", "zcylinder"})
 """The primitive wall kinds (``pyhost.walls.PRIMITIVES``) whose contacts the recorder notes
 (``planes``, ``cylinders``; plugins/liggghts/contact_events.cpp). A kind of pyhost.walls that
