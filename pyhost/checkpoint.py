@@ -6,9 +6,10 @@ coupling loop calls :func:`write` at the end of a step. It writes OUT/.checkpoin
 - ``dem.restart``: LIGGGHTS' ``write_restart`` (atoms, the per-atom ``Temp`` of ``fix
   property/atom Temp ... restart yes``, the tangential contact history of ``fix
   contacthistory`` and of the primitive walls);
-- ``host.npz``: the host's arrays (open contacts' keys and, aligned, their start, t_coll, e, v0
-  and normal;
-  m c T by id; the ids seen) and each atom's force and torque of the last step;
+- ``host.npz``: the host's arrays (the separation speeds handed to the contact recorder and
+  not imposed yet, with restitution feedback; m c T by id; the ids seen) and each atom's
+  force and torque of the last step (the recorder's own open contacts are primed again from
+  the restart: contacts present then are open, not collisions);
 - ``host.json``: the host's values (totals, CT0, steps, warnings given, the byte size of
   collisions.csv, or the rows of the binary collision log, and of history.csv, and the VTK
   frames at this step);

@@ -21,8 +21,8 @@ class Contacts:
     """Contacts, one row each: ``i`` a particle (index or atom id); ``j`` a particle, or
     WALL_BASE + wall index; overlap ``delta`` [m]; unit ``normal`` from j to i; ``approach`` =
     -(v_i - v_j).n [m/s] (> 0 while closing in); ``heat_flux`` [W] into i by a script's fix
-    heat/gran (zeros without). The one form of a contact list, whether from positions (here),
-    from LIGGGHTS' computes or from the walls' geometry (pyhost.engines.dem)."""
+    heat/gran (zeros without). The form of a contact list that ``pyhost post`` finds in dump
+    frames without contact dumps."""
 
     i: np.ndarray
     j: np.ndarray

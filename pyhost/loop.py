@@ -16,7 +16,7 @@ which runs the DEM in chunks and hands the particles to the effects the scene as
 
 Temperatures live in LIGGGHTS' per-atom ``Temp``: the host reads and writes them there and
 keeps no copy. A dry, isothermal scene runs the DEM and the frames only. How a contact is
-classified (collision, then enduring) is told in ``pyhost.collisions``.
+classified (collision, then enduring) is told in ``pyhost.effects.collisions``.
 """
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ from pyhost.script import ScriptError, parse_run, replay
 
 HARVEST_EVERY = 1000
 """DEM steps between harvests of the contact events at most (they are also taken at every
-frame, checkpoint and sample, and at a fluid exchange that reads temperatures): bounds the
+frame and checkpoint, and at a fluid exchange that reads temperatures): bounds the
 recorder's buffer and the wait of a signal (a stop is taken between two DEM chunks)."""
 
 
@@ -107,10 +107,8 @@ class Coupling:
         self.frames = Frames(self, groups, [self.fluid_exchange] if fluid is not None else [], logs)
         self.effect_list = [e for e in (self.balance, self.collisions, self.fluid_exchange, self.frames) if e is not None]
         self.progress = Progress(end or math.inf, progress_every)
-        events = self.collisions is not None and self.collisions.events
-        sampled = self.collisions is not None and self.collisions.sampled
-        self.every = dict(sample=scene.time.sample_every if sampled else 0,
-                          harvest=(scene.time.sample_every if self.collisions.restitution else HARVEST_EVERY)
+        events = self.collisions is not None
+        self.every = dict(harvest=(scene.time.sample_every if self.collisions.restitution else HARVEST_EVERY)
                           if events else 0,
                           frame=0,                    # (set just below, and at each run of a script)
                           couple=scene.time.couple_every if fluid is not None else 0,
@@ -208,7 +206,7 @@ class Coupling:
             signals.check()
         if self.fluid_exchange is not None:     # the last advance, if it ran beside the DEM: a failure
             self.fluid_exchange.fluid.wait()    # in it stops this run like any other (summary, exit 3)
-        if self.heat or (self.collisions is not None and self.collisions.events):
+        if self.heat or self.collisions is not None:
             atoms = self.dem.atoms(self.heat)
             self.track_particles(atoms)
             if self.collisions is not None:
@@ -339,8 +337,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     def prepare(cmd):
         try:
             added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
-                                fluid_force=fluid is not None,
-                                events=scene.time.contacts == "events")
+                                fluid_force=fluid is not None)
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
         log("host adds to the script: " + ("; ".join(added) if added else "nothing"))

@@ -196,15 +196,9 @@ class Time:
     end: float = spec(">=0", 0.0, "simulated time [s] (box scenes; a script's runs set it, except a CFD-DEM "
                                   "script's final 'run 0', which the coupling drives for this long, else for "
                                   "the fluid case's controlDict endTime)")
-    contacts: str = spec("in:events,samples", "events",
-                         "how collisions are found: 'events', recorded inside LIGGGHTS at every step (the "
-                         "impact speed as it is at first touch, no collision missed; on every rank under MPI; "
-                         "a mesh wall without a fix wall/gran of its own is sampled beside them), or "
-                         "'samples' of LIGGGHTS' contact lists every sample_every steps (the reference the "
-                         "events were checked against; docs/contact-events.md)")
-    sample_every: int = spec(">0", 1, "DEM steps between contact samples (with contact events: of the mesh "
-                                      "walls the recorder cannot take only, 10 missing 6 % of chute_wear's wall "
-                                      "contacts; and, with restitution feedback, between harvests)")
+    sample_every: int = spec(">0", 1, "DEM steps between harvests of the contact events with restitution "
+                                      "feedback: a contact shorter than this gets its separation speed at the "
+                                      "harvest, late (restitution_late in summary.json)")
     couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
 
@@ -264,6 +258,14 @@ class Scene:
         )
 
 
+RETIRED = {
+    "time.contacts": "retired: collisions come from contact events recorded inside LIGGGHTS at every step "
+                     "(docs/contact-events.md); sampling the contact lists is gone from runs (post still "
+                     "reads contact dumps)",
+}
+"""Keys a scene may still carry from an earlier version, and why they went."""
+
+
 def build(cls, data, where: str, file: str):
     """The dataclass ``cls`` filled from one TOML table ``data`` (at key ``where`` of ``file``):
     every key known, every value of its type and within its rule; SceneError naming the file
@@ -273,6 +275,8 @@ def build(cls, data, where: str, file: str):
     fields = {f.name: f for f in dataclasses.fields(cls)}
     hints = typing.get_type_hints(cls)
     for key in data:
+        if f"{where}.{key}" in RETIRED:
+            raise SceneError(f"{file}: {where}.{key}: {RETIRED[f'{where}.{key}']}; remove the key")
         if key not in fields:
             raise SceneError(f"{file}: {where}.{key}: unknown key; known: {', '.join(fields)}")
     values = {}

@@ -15,7 +15,6 @@ import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from pyhost.dumps import LOCAL_DEFAULT, LOCAL_GROUPS
 from pyhost.walls import PRIMITIVES
 
 REFUSED = {
@@ -256,35 +255,14 @@ def parse_wall(cmd: Command) -> GranWall | None:
     raise ScriptError(f"{cmd.where()}: fix wall/gran with neither 'primitive' nor 'meshes'")
 
 
-def local_columns(keywords: list[str], total: int) -> dict:
-    """Column slice of each keyword group of a ``compute pair/gran/local`` (or wall/gran/local)
-    with these keywords, in LIGGGHTS' code order (``pyhost.dumps.LOCAL_GROUPS``, the one table
-    of that order). ``history`` has as many columns as the pair style keeps: found from
-    ``total``, the compute's column count."""
-    words = [k for k in keywords if k in LOCAL_GROUPS] or list(LOCAL_DEFAULT)
-    widths = {k: sum(n or 0 for _, n in LOCAL_GROUPS[k][0]) for k in words}
-    if "history" in words:
-        widths["history"] = total - sum(widths.values())
-    cols, at = {}, 0
-    for key in (k for k in LOCAL_GROUPS if k in words):
-        cols[key] = slice(at, at + widths[key])
-        at += widths[key]
-    if at != total:
-        raise ScriptError(f"a compute with keywords {' '.join(keywords)} has {at} columns, LIGGGHTS gave {total}")
-    return cols
-
-
 @dataclass
 class ScriptInfo:
     """What the host learns from the commands run so far."""
 
     walls: dict = field(default_factory=dict)           # fix id -> GranWall
     mesh_types: dict = field(default_factory=dict)      # fix mesh/surface id -> atom type of the wall
-    pair_compute: tuple | None = None                   # (id, keywords) of compute pair/gran/local
-    wall_compute: tuple | None = None                   # (id, keywords) of compute wall/gran/local
     heat_gran: str | None = None                        # id of fix heat/gran
     temp_fix: bool = False                              # a fix property/atom Temp exists
-    pair_model: str = ""                                # the pair style's normal model
     globals: dict = field(default_factory=dict)         # property/global name -> fix id
     periodic: tuple = (False, False, False)             # from the boundary command
     mesh_motions: list = field(default_factory=list)    # ids of the fix move/mesh defined now
@@ -328,12 +306,7 @@ class ScriptInfo:
             self.randoms = [k for k in self.randoms if k.split(" ", 1)[1] != w[1] or k.startswith("region ")]
             if self.heat_gran == w[1]:
                 self.heat_gran = None
-        elif w[0] == "compute" and len(w) >= 4 and w[3] in ("pair/gran/local", "wall/gran/local"):
-            which = "pair_compute" if w[3] == "pair/gran/local" else "wall_compute"
-            setattr(self, which, (w[1], w[4:]))
         elif w[0] == "region" and len(w) >= 3:
             self._random("region " + w[1], w[2] != "delete")
         elif w[0] == "boundary" and len(w) >= 4:
             self.periodic = tuple(b == "p" for b in w[1:4])
-        elif w[0] == "pair_style" and len(w) >= 4 and w[1] == "gran" and w[2] == "model":
-            self.pair_model = w[3]

@@ -164,10 +164,6 @@ def user_script(scene):
         for fix in known:
             if fix not in named and fix not in told:
                 print(f"LIGGGHTS wall {fix!r} has no [[walls]] entry: adiabatic for collision heat")
-        mesh = [f for f, w in known.items() if w.meshes]
-        if len(mesh) > 1 and not told.issuperset(known):
-            print(f"warning: LIGGGHTS lists the contacts of one mesh wall fix only ({mesh[-1]!r}); "
-                  f"collisions with {', '.join(mesh[:-1])} are not seen")
         told.update(known)
         return [HostWall(f, *named.get(f, (-1, np.nan)), mesh=k)
                 for f, wall in known.items() for k in range(max(len(wall.meshes), 1))]

@@ -72,6 +72,8 @@ dump d3 all custom 20 post/fine.dump id type x y z vx vy vz radius
 dump dv all custom/vtk 500 post/p_*.vtk id type x y z vx vy vz radius
 dump dl all local 20 post/pair.* {pair}
 dump dw all local 20 post/wall.* {wall}
+dump dl1 all local 1 post/pairs_every_step.dump {pair}
+dump dw1 all local 1 post/walls_every_step.dump {wall}
 run 6000
 """
 
@@ -119,7 +121,8 @@ conductivity = 1.0
 def pour_dumps(tmp_path_factory):
     """Dumps of a 60-particle pour on Debian's LIGGGHTS (about 1 s): post/dump.* (one step a
     file, f_Temp[0]), post/all.dump (every step in one file, scrambled columns, f_Temp),
-    post/p_*.vtk (custom/vtk), post/fine.dump (every 20 steps), post/pair.* and post/wall.* (contacts every 20 steps)."""
+    post/p_*.vtk (custom/vtk), post/fine.dump (every 20 steps), post/pair.* and post/wall.* (contacts every 20 steps),
+    post/pairs_every_step.dump and post/walls_every_step.dump (contacts at every step, one file each)."""
     import shutil
     import subprocess
 

@@ -244,8 +244,8 @@ def main() -> None:
         if args.fluid_step:
             fluid_step_table(base, weight, tmp)
             return
-        print(f"\n1. cost of each effect, from the initial placement (contacts sampled every "
-              f"{base.time.sample_every} steps, fluid coupled every {base.time.couple_every}; best of {args.repeat})")
+        print(f"\n1. cost of each effect, from the initial placement (fluid coupled every "
+              f"{base.time.couple_every} steps; best of {args.repeat})")
         print(f"{'effects':>40} | {'wall s per simulated s':>22} | collisions")
         rows = (("plain DEM, no fluid (isothermal)", {"fluid": False, "contact_heat": "none"}),
                 ("fluid only (isothermal)", {"contact_heat": "none"}),

@@ -5,8 +5,7 @@ default outputs (``python -m pyhost run``), one after the other in one process, 
 ratio of their wall times. The host's time includes its start-up (Python, the plugin's tables,
 LIGGGHTS set-up: about 2 s).
 
-    .venv/bin/python tools/bench_corpus.py [--only packing conveyor] [--contacts samples] \
-        [--cfdem CFDEMcoupling-PUBLIC checkout]
+    .venv/bin/python tools/bench_corpus.py [--only packing conveyor] [--cfdem CFDEMcoupling-PUBLIC checkout]
 
 Debian's tutorials: packing, heatTransfer_1, chute_wear, conveyor (liggghts-doc); CFDEM's
 fillCylinder (tutorials/cfdemPostproc/fillCylinder/DEM/in.liggghts_init: 2,000 particles of two
@@ -74,16 +73,12 @@ def main(argv=None) -> int:
     ap.add_argument("--only", nargs="+", choices=list(SCRIPTS) + list(CFDEM) + list(OWN) + [BOX])
     ap.add_argument("--cfdem", type=Path, help="a CFDEMcoupling-PUBLIC checkout, for fillCylinder")
     ap.add_argument("--work", type=Path, default=Path("/tmp/collheat-bench-corpus"))
-    ap.add_argument("--contacts", choices=("events", "samples"), default="events",
-                    help="[time] contacts of the host's runs (samples: as before contact events)")
     args = ap.parse_args(argv)
     args.work.mkdir(parents=True, exist_ok=True)
     jobs = []                           # (name, case folder, script, its native variables, host options)
     for tut in corpus.TUTORIALS:
         if tut.name in SCRIPTS and (not args.only or tut.name in args.only):
             copy = corpus.prepare(tut, None, args.work)
-            toml = copy / tut.case_dir / "case.toml"
-            toml.write_text(toml.read_text() + f'\n[time]\ncontacts = "{args.contacts}"\n')
             jobs.append((tut.name, copy, SCRIPTS[tut.name], [], []))
     for name, (folder, script, density) in CFDEM.items():
         if args.only and name not in args.only:
@@ -96,8 +91,7 @@ def main(argv=None) -> int:
         shutil.copytree(args.cfdem / folder, copy)
         (copy / "post").mkdir(exist_ok=True)
         materials = corpus.MATERIAL.format(density=density, cp=840.0, T=300.0).replace("types = [1]", "types = [1, 2]")
-        (copy / "case.toml").write_text(f'[dem]\nscript = "{script}"\n\n[effects]\ncontact_heat = "A"\n\n'
-                                        f'[time]\ncontacts = "{args.contacts}"\n' + materials)
+        (copy / "case.toml").write_text(f'[dem]\nscript = "{script}"\n\n[effects]\ncontact_heat = "A"\n\n' + materials)
         jobs.append((name, copy, script, [], []))
     for name, (script, variables, options) in OWN.items():
         if not args.only or name in args.only:
@@ -105,15 +99,11 @@ def main(argv=None) -> int:
             shutil.rmtree(copy, ignore_errors=True)
             shutil.copytree(ROOT / "cases" / name, copy, ignore=shutil.ignore_patterns("output", "post"))
             (copy / "post").mkdir()
-            toml = copy / "case.toml"
-            toml.write_text(toml.read_text().replace("[time]\n", f'[time]\ncontacts = "{args.contacts}"\n', 1))
             jobs.append((name, copy, script, variables, options))
     if not args.only or BOX in args.only:
         copy = box_27k(args.work)
-        toml = copy / "case.toml"
-        toml.write_text(toml.read_text().replace("[time]\n", f'[time]\ncontacts = "{args.contacts}"\n', 1))
         jobs.append((BOX, copy, None, [], []))
-    print(f"{'input':<16} {'native s':>9} {'host s':>8} {'ratio':>6} {'(host-2)/native':>16}  host: collisions, contacts")
+    print(f"{'input':<16} {'native s':>9} {'host s':>8} {'ratio':>6} {'(host-2)/native':>16}  host: collisions")
     rows = []
     for name, copy, script, variables, options in jobs:
         out = copy / "host-output"
@@ -135,11 +125,9 @@ def main(argv=None) -> int:
             print(f"{name:<16} native run failed (rc {n.returncode})")
             continue
         s = json.loads((out / "summary.json").read_text())
-        added = next((ln for ln in r.stdout.splitlines() if ln.startswith("host adds to the script")), "")
-        mode = "events" if "collheat_events" in added else "samples"
         rows.append((name, native, host))
         print(f"{name:<16} {native:9.2f} {host:8.2f} {host / native:6.2f} {(host - START) / native:16.2f}  "
-              f"{s['collisions']}, {mode}", flush=True)
+              f"{s['collisions']}", flush=True)
     return 0
 
 

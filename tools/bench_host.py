@@ -6,9 +6,8 @@ the script's set-up commands), except in section 2.
    heat (fast and exact paths), restitution feedback and enduring conduction.
 2. The host's overhead: the same dry scene (no effects) through the host and through
    the native ``liggghts`` binary with the same input.
-3. What the sampling interval costs in accuracy: impact speeds and total heat against
-   sampling every DEM step (median and 90th percentile of the per-collision error of v0,
-   error of the total heat moved, collisions missed).
+3. (Gone with the sampled contacts in session 33: what the sampling interval cost in
+   accuracy. Collisions come from contact events recorded at every step.)
 4. Heat against plain DEM by size: the scene grown to N particles at the same packing, wall
    time per DEM step without heat and with heat A (fast path), their ratio, and the cost
    per collision (extra wall time / collisions); with ``--baseline TREE`` the same on the
@@ -18,7 +17,7 @@ the script's set-up commands), except in section 2.
    with its CSV only.
 
 Run (PYTHONPATH: the checkout to measure; the .venv's editable install points at /work/main):
-     PYTHONPATH=. .venv/bin/python tools/bench_host.py [--time 0.01] [--sections 1 2 3 4]
+     PYTHONPATH=. .venv/bin/python tools/bench_host.py [--time 0.01] [--sections 1 2 4]
      [--particles 1000 8000 27000] [--size-time 0.002] [--repeat 1] [--collisions csv binary]
      [--baseline /path/to/old/checkout]
 """
@@ -35,7 +34,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 
 from pyhost.dem_input import input_lines, place_particles, write_data
 from pyhost.scene import load_scene
@@ -143,36 +141,10 @@ def run_native(scene, out: Path) -> float:
     return time.perf_counter() - t
 
 
-def collisions(out: Path) -> dict:
-    """Collisions by partners: {(i, j, wall): [(start time, v0), ...]}."""
-    found = {}
-    from pyhost.output import read_collisions       # here: a baseline checkout may lack it
-
-    c = read_collisions(out)
-    for i, j, w, t, v0 in zip(*(c[k].tolist() for k in ("i", "j", "wall", "time", "v0"))):
-        found.setdefault((i, j, w), []).append((t, v0))
-    return found
-
-
-def matched_errors(ref: dict, got: dict, window: float):
-    """Relative v0 errors of the reference collisions found again within ``window`` [s] of
-    their start, and how many were not found."""
-    errors, missed = [], 0
-    for key, events in ref.items():
-        candidates = got.get(key, [])
-        for t, v0 in events:
-            near = [v for s, v in candidates if abs(s - t) <= window]
-            if near:
-                errors.append(abs(near[0] / v0 - 1))
-            else:
-                missed += 1
-    return np.array(errors), missed
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--time", type=float, default=0.01, help="simulated time per run of sections 1-3 [s]")
-    ap.add_argument("--sections", type=int, nargs="+", default=[1, 2, 3, 4], choices=[1, 2, 3, 4])
+    ap.add_argument("--time", type=float, default=0.01, help="simulated time per run of sections 1-2 [s]")
+    ap.add_argument("--sections", type=int, nargs="+", default=[1, 2, 4], choices=[1, 2, 4])
     ap.add_argument("--particles", type=int, nargs="+", default=[1000, 8000, 27000], metavar="N",
                     help="section 4: particle counts (the scene grown at its packing)")
     ap.add_argument("--size-time", type=float, default=0.002, help="section 4: simulated time per run [s]")
@@ -197,8 +169,6 @@ def main() -> None:
             effect_costs(base, args.time, tmp)
         if 2 in args.sections:
             host_overhead(base, args.time, tmp)
-        if 3 in args.sections:
-            sampling_accuracy(base, args.time, tmp)
         if 4 in args.sections:
             print(f"\n4. heat A (fast path) against plain DEM, {args.size_time:g} s simulated "
                   f"({round(args.size_time / base.time.dem_step)} steps) per run, engines' set-up not counted, "
@@ -228,7 +198,7 @@ def baseline_sizes(tree: Path, sizes, sim_time: float, repeat: int) -> list[dict
 
 
 def effect_costs(base, sim_time: float, tmp: Path) -> None:
-    print("\n1. cost of each effect (sampling every", base.time.sample_every, "steps)")
+    print("\n1. cost of each effect")
     print(f"{'effects':>44} | {'wall s per simulated s':>22} | collisions")
     rows = (("plain DEM (isothermal)", dict(contact_heat="none")),
             ("collision heat A, fast path", dict(contact_heat="A", heat_path="fast")),
@@ -249,24 +219,6 @@ def host_overhead(base, sim_time: float, tmp: Path) -> None:
     print(f"native liggghts {native:.2f} s, host {host:.2f} s: overhead {100 * (host / native - 1):+.1f} % "
           f"(best of 2; both with their start-up)")
 
-
-def sampling_accuracy(base, sim_time: float, tmp: Path) -> None:
-    print("\n3. sampling interval: accuracy against sampling every step")
-    ref_scene = dataclasses.replace(variant(base, sim_time, contact_heat="A", heat_path="fast"),
-                                    time=dataclasses.replace(base.time, end=sim_time, sample_every=1))
-    wall_ref, ref_summary = run_host(ref_scene, tmp / "sample1")
-    ref = collisions(tmp / "sample1")
-    print(f"{'every k steps':>13} | {'wall s/sim s':>12} | {'v0 err median':>13} {'p90':>9} | "
-          f"{'total Q err':>11} | missed")
-    print(f"{1:>13} | {wall_ref / sim_time:12.1f} | {'(reference)':>13} {'':>9} | {'':>11} | "
-          f"of {ref_summary['collisions']}")
-    for k in (2, 5, 10, 20, 50):
-        sc = dataclasses.replace(ref_scene, time=dataclasses.replace(ref_scene.time, sample_every=k))
-        wall, summary = run_host(sc, tmp / f"sample{k}")
-        err, missed = matched_errors(ref, collisions(tmp / f"sample{k}"), 1.01 * k * base.time.dem_step)
-        dq = summary["heat_moved"] / ref_summary["heat_moved"] - 1
-        print(f"{k:>13} | {wall / sim_time:12.1f} | {np.median(err):13.2e} {np.percentile(err, 90):9.2e} | "
-              f"{dq:+11.2e} | {missed}")
 
 if __name__ == "__main__":
     main()

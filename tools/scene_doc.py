@@ -28,7 +28,7 @@ SECTIONS = (
     ("[[walls]]", S.Wall, "A wall's real material and temperature: by plane (box scenes) or by the id of "
                           "the script's fix wall/gran (script scenes). A script wall with no entry is adiabatic."),
     ("[domain]", S.Domain, "Box scenes: the box."),
-    ("[time]", S.Time, "Time steps and sampling."),
+    ("[time]", S.Time, "Time steps, fluid coupling and harvests."),
     ("[fluid]", S.Fluid, "The gas, solved by collheatFoam."),
     ("[output]", S.Output, "What a run writes."),
 )

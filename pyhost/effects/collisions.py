@@ -1,31 +1,32 @@
 """Collision heat, restitution and the collision log: every contact that begins is a collision,
-its impact speed recorded at first touch inside LIGGGHTS (contact events, pyhost.engines.events)
-or recovered from samples of the contact lists (``time.contacts = "samples"``), its heat from
-the plugin moved at once, the model's restitution imposed at its end if asked, a script's
-fix heat/gran undone during the collision's model time. Present when the scene needs contacts
-(``contact_extraction``: collision heat or restitution feedback). SI units.
+its impact speed recorded at first touch inside LIGGGHTS (contact events, pyhost.engines.events),
+its heat from the plugin moved at the next harvest in the order of the collisions, the
+model's restitution imposed at its end if asked, a script's fix heat/gran undone during the
+collision's model time. Present when the scene needs contacts (``contact_extraction``:
+collision heat or restitution feedback). SI units.
 
-How a sampled contact is classified (collision, then enduring) is told in ``pyhost.collisions``.
+How a contact is classified. A contact begins at the first step the recorder finds the two
+overlapping (``r_i + r_j - |x_i - x_j| > 0``, LIGGGHTS' own test) and ends at the first step
+it does not. Its begin is a collision; the collision's heat Q accounts for the first t_coll
+of the contact, the collision's duration under the real material's model. A contact that is
+still open after t_coll is *enduring*. From then on it conducts only through the script's
+fix heat/gran (or the box scenes' ``enduring_conduction``), if any, whose flux during the
+first t_coll is taken back. So no stretch of a contact's time is counted twice. Contacts
+present at the start (or a restart) are open and enduring, not collisions.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from plugins.dem.hertz import DemHertz, effective_modulus, impact_speeds, reduced
 from plugins.dem.impulse import restitution_impulse
 from plugins.heat.batch import evaluate_flagged, side_heat
 from plugins.heat.exchange import exchange_heat, temperature_difference
-from pyhost.collisions import WALL_BASE, ContactTracker, contact_keys
+from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.effects import Effect
 from pyhost.engines.events import BEGIN, END
 from pyhost.output import ColumnLog, CsvLog, collision_kinds
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
-OPEN_COLUMNS = ("start", "t_coll", "e", "v0", "nx", "ny", "nz")
-"""What the host keeps of each open contact: start time [s], model duration [s], the model's
-restitution (NaN: none to impose), impact speed [m/s] and unit normal at the start."""
 
 
 class CollisionHeat(Effect):
@@ -34,20 +35,15 @@ class CollisionHeat(Effect):
 
     def __init__(self, loop, walls, logs: dict | None = None):
         super().__init__(loop)
-        scene, dem = loop.scene, loop.dem
-        self.tracker = ContactTracker()
-        self.info = np.empty((0, len(OPEN_COLUMNS)))   # per open contact, rows aligned with tracker.open_keys
-        self.laws = {}
-        self.events = dem.events is not None     # contacts recorded inside LIGGGHTS (else sampled)
+        scene = loop.scene
         self.t_coll_of = {}                      # (key, begin step) -> t_coll [s] of pair collisions under heat/gran
-        self.restitution = self.events and scene.effects.restitution_feedback and loop.heat
+        self.restitution = scene.effects.restitution_feedback and loop.heat
         self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
         columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
         mark = (logs or {}).get("collisions")
         self.log = (ColumnLog(loop.out / "collisions", collision_kinds(columns), mark)
                     if scene.output.collisions == "binary" else CsvLog(loop.out / "collisions.csv", columns, mark))
         self.update_walls(walls)
-        self.sampled = not self.events or dem.sampled_walls()   # (after the recorder took the walls it can)
 
     @property
     def dem(self):
@@ -71,55 +67,43 @@ class CollisionHeat(Effect):
         self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
         self.T_wall = np.array([w.temperature if self.loop.effects["wall_heat"] else np.nan for w in walls])
         self.wall_material = np.array([w.material for w in walls], int)
-        if self.dem.events is not None:
-            self.dem.event_planes(self.wall_index)
-
-    def start(self) -> None:
-        if self.loop.every["sample"]:
-            self.open_present()
+        self.dem.event_planes(self.wall_index)
 
     def after_chunk(self, due: dict):
-        """The contacts' work at the end of a DEM chunk: the events harvested, the contact
-        lists sampled, as due. Returns the atoms it gathered (None if it gathered none)."""
+        """The contacts' work at the end of a DEM chunk: the events harvested, if due. Returns
+        the atoms it gathered (None if it gathered none)."""
         loop = self.loop
-        if self.events and self.harvest_alone(due):
+        if self.harvest_alone(due):
             self.harvest_partly()
             return None
-        if not (due["sample"] or (self.events and self.wants_harvest(due))):
+        if not self.wants_harvest(due):
             return None
         atoms = self.dem.atoms(loop.heat)
         loop.track_particles(atoms)
-        if self.events:
-            self.harvest(atoms, final=bool(due["checkpoint"]))
-        if due["sample"]:
-            self.sample_contacts(atoms)
+        self.harvest(atoms, final=bool(due["checkpoint"]))
         return atoms
 
     def wants_harvest(self, due: dict) -> bool:
-        """Whether this chunk's end needs the events taken now: a harvest, a frame, a sample or a
+        """Whether this chunk's end needs the events taken now: a harvest, a frame or a
         checkpoint is due, or a fluid exchange that reads the temperatures (convection) or
         comes while a fix heat/gran conducts. A fluid exchange without either changes no
         temperature and reads none: the events wait for the next of the others, in larger
         batches (the heat moved is the same, collision after collision in their order)."""
         convects = self.loop.fluid_exchange is not None and self.loop.fluid_exchange.convection
-        return any(due[k] for k in ("harvest", "frame", "sample", "checkpoint")) or (
+        return any(due[k] for k in ("harvest", "frame", "checkpoint")) or (
             due["couple"] and (convects or bool(self.dem.events.window)))
 
     def end_of_run(self, atoms) -> None:
         """At the end of each of the script's runs: the events so far."""
-        if self.events:
-            self.harvest(atoms)
+        self.harvest(atoms)
 
     def state(self) -> tuple[dict, dict]:
         return (dict(logs=dict(collisions=self.log.mark())),
-                dict(open_keys=self.tracker.open_keys, contact_info=self.info,
-                     target_keys=np.array(list(self.targets), np.int64),
+                dict(target_keys=np.array(list(self.targets), np.int64),
                      target_speed=np.array([v[0] for v in self.targets.values()]),
                      target_normal=np.array([v[1] for v in self.targets.values()]).reshape(-1, 3)))
 
     def restore(self, state: dict) -> None:
-        self.tracker.update(state["open_keys"])
-        self.info = np.asarray(state["contact_info"], float).reshape(-1, len(OPEN_COLUMNS))
         if self.restitution and len(state.get("target_keys", ())):   # separation speeds of contacts still open
             self.dem.events.restitution(state["target_keys"], state["target_speed"], state["target_normal"])
             self.targets = dict(zip(state["target_keys"].tolist(),
@@ -127,41 +111,6 @@ class CollisionHeat(Effect):
 
     def close(self) -> None:
         self.log.close()
-
-    def open_present(self) -> None:
-        """The contacts present now count as open, enduring (t_coll 0: no collision time to
-        account for), with no restitution to impose at their end (e NaN)."""
-        c = self.dem.contacts(self.dem.atoms(self.loop.heat), self.wall_index)
-        keys = contact_keys(c.i, c.j)
-        self.tracker.update(keys)
-        n = len(keys)
-        self.info = np.column_stack([np.full(n, self.loop.t), np.zeros(n), np.full(n, math.nan), np.full(n, math.nan),
-                                     np.asarray(c.normal, float).reshape(n, 3)])
-
-    def sample_contacts(self, atoms) -> None:
-        c = self.dem.contacts(atoms, self.wall_index)
-        keys = contact_keys(c.i, c.j)
-        last_keys, last = self.tracker.open_keys, self.info
-        opened, closed, prev = self.tracker.match(keys)
-        self.info = np.empty((len(keys), len(OPEN_COLUMNS)))
-        kept = prev >= 0
-        self.info[kept] = last[prev[kept]]
-        if len(opened):
-            self.start_collisions(atoms, c, keys, opened)
-        if len(closed):
-            self.end_collisions(atoms, last_keys[closed], last[closed])
-        if self.loop.heat and self.dem.info.heat_gran and len(c):
-            self.undo_heat_gran(atoms, c)
-
-    def dem_law(self, a: int, b: int) -> DemHertz:
-        """The DEM's Hertz law between atom types a and b, from the script's own values
-        (LIGGGHTS' effective modulus and per-pair restitution); read once per pair."""
-        if (a, b) not in self.laws:
-            E = self.dem.type_values("youngsModulus", (a, b))
-            nu = self.dem.type_values("poissonsRatio", (a, b))
-            e = self.dem.type_pair_value("coefficientRestitution", a, b)
-            self.laws[a, b] = DemHertz(effective_modulus(E[0], nu[0], E[1], nu[1]), e)
-        return self.laws[a, b]
 
     def flag_outside_range(self, flagged, v0) -> None:
         """Collisions the contact models do not cover (plugins.heat.validity, as ``collide`` flags
@@ -212,15 +161,15 @@ class CollisionHeat(Effect):
         """The contact events recorded inside LIGGGHTS since the last harvest: each begun
         contact is a collision, at its impact speed as recorded at first touch, its heat moved
         now in the order the collisions happened. Without a fix heat/gran nothing else changes
-        a temperature between two harvests (they come at every fluid exchange, frame and
-        sample), so the heat is what it would be if moved at each collision's own step; with
+        a temperature between two harvests (they come at every frame and checkpoint, at a fluid
+        exchange that reads the temperatures, and at least every HARVEST_EVERY steps), so the heat is what it would be if moved at each collision's own step; with
         one, each collision takes the temperature difference it began with (the recorder notes
         the two temperatures at its first step), and what heat/gran conducted through each new
         contact during the collision's model time is taken back (``take_back_heat_gran``;
         ``final``: also for contacts younger than its window, at a checkpoint or the end). A
         collision whose particle left the simulation before the harvest (deleted, out of the
         box) is counted apart (collisions_of_departed) and moves no heat: its heat content left
-        at its last sample; so is one that began with no approach speed
+        when it was last seen; so is one that began with no approach speed
         (contacts_without_impact)."""
         ev = self.dem.events.take() if ev is None else ev
         begin, ends = ev[ev["kind"] == BEGIN], ev[ev["kind"] == END]
@@ -289,8 +238,8 @@ class CollisionHeat(Effect):
         """Restitution feedback on contact events: each collision's separation speed e v0 (e
         above 1 clipped, counted) handed to the recorder, which imposes it at the step the
         contact ends. A contact that ended before this harvest (shorter than the harvest
-        interval, time.sample_every steps) gets it now, from the velocities now, as the samples
-        did (counted as restitution_late)."""
+        interval, time.sample_every steps) gets it now, from the velocities now (counted as
+        restitution_late)."""
         e, v0 = at[:, 2], at[:, 3]
         self.totals["clipped"] += int(np.sum(e > 1.0))
         speed = np.minimum(e, 1.0) * v0
@@ -314,7 +263,7 @@ class CollisionHeat(Effect):
         collision's model duration t_coll, taken back (the collision heat stands for that time):
         from the recorder's flux history of the contact, step m from the begin carrying flux f_m
         [W] over dt, Q = dt sum_m f_m clip(t_coll / dt - m, 0, 1) [J] into the smaller id. Exact
-        per step, where the samples took the flux at each sample over the sample interval."""
+        per step."""
         i, j, start, filled, flux = self.dem.events.histories(all=final)
         if not len(i):
             return
@@ -337,27 +286,12 @@ class CollisionHeat(Effect):
         np.add.at(atoms.T, b, q / self.loop.C[b])
         self.totals["heat_gran_undone"] += float(np.abs(q).sum())
 
-    def start_collisions(self, atoms, c, keys, rows) -> None:
-        i = atoms.index(c.i[rows])
-        wall, jl, mj, tj, R_j, m_j = self.partners(atoms, i, c.j[rows])
-        R_eff, m_eff = reduced(atoms.radius[i], R_j, atoms.mass[i], m_j)
-        delta, approach = c.delta[rows], c.approach[rows]
-        v0 = np.abs(approach)
-        if self.dem.info.pair_model == "hertz":
-            v0 = impact_speeds(v0, self.dem_law, atoms.type[i], tj, delta, approach, R_eff, m_eff,
-                               self.loop.every["sample"] * self.dem.dt)
-        elif "model" not in self.warned:
-            self.warned.add("model")
-            print(f"warning: the DEM's normal model is '{self.dem.info.pair_model}', not hertz: impact speeds "
-                  "are the approach speeds at the first sample in contact, not integrated back to touch")
-        at = self.collide(atoms, c.i[rows], c.j[rows], v0, c.normal[rows], np.full(len(rows), self.loop.t))
-        self.info[rows] = at
-
     def collide(self, atoms, ids_i, j, v0, normal, time, T_begin=None) -> np.ndarray:
         """Collisions of particles ``ids_i`` with partners ``j`` (ids, or WALL_BASE + wall) at
         impact speeds v0 [m/s] with unit normals (j to i), begun at ``time`` [s]: the plugin's
-        heat moved in this order, the totals and the collision log. Returns their OPEN_COLUMNS
-        rows. ``T_begin`` (n, 2) [K]: the two temperatures when each began (NaN: as now), where
+        heat moved in this order, the totals and the collision log. Returns, per collision, its
+        time [s], model duration t_coll [s], the model's restitution e (NaN: none to impose),
+        impact speed [m/s] and unit normal. ``T_begin`` (n, 2) [K]: the two temperatures when each began (NaN: as now), where
         something else (a fix heat/gran) changed them since: each collision's temperature
         difference is the one it began with, plus what earlier collisions of this batch moved."""
         i = atoms.index(ids_i)
@@ -400,15 +334,6 @@ class CollisionHeat(Effect):
         that moved it and the side models on the same collisions."""
         return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
 
-    def end_collisions(self, atoms, closed, info) -> None:
-        """Contacts gone since the last sample (their keys and OPEN_COLUMNS rows): with
-        restitution feedback, the model's e imposed on the pair's normal velocity."""
-        if not self.scene.effects.restitution_feedback or not self.loop.heat:
-            return
-        ids_i = (closed >> 31).astype(np.int64)
-        ids_j = (closed & ((1 << 31) - 1)).astype(np.int64)
-        self.totals["clipped"] += self.impose_separation(atoms, ids_i, ids_j, info[:, 4:7], info[:, 2], info[:, 3])
-
     def impose_separation(self, atoms, ids_i, ids_j, normal, e, v0) -> int:
         """The model's separation speed e v0 [m/s] imposed now on each pair's normal velocity
         (particles ``ids_i`` and ``ids_j``, or WALL_BASE + wall: the line of centres, nearest
@@ -434,27 +359,10 @@ class CollisionHeat(Effect):
             self.dem.add_velocity(jl[pair], dv_j[pair])
         return clipped
 
-    def undo_heat_gran(self, atoms, c) -> None:
-        """The script's fix heat/gran conducts through every contact; during a collision's
-        model duration t_coll the collision heat already stands for that time, so what heat/gran
-        moved then is taken back: flux at this sample [W] times the part of the sample interval
-        inside [start, start + t_coll] (exact when sampling every step)."""
-        dt_s = self.loop.every["sample"] * self.dem.dt
-        start, t_coll = self.info[:, 0], self.info[:, 1]
-        tau = np.clip(start + t_coll - (self.loop.t - dt_s), 0.0, dt_s)
-        rows = np.flatnonzero((tau > 0) & (c.j < WALL_BASE))
-        if not len(rows):
-            return
-        i, j = atoms.index(c.i[rows]), atoms.index(c.j[rows])
-        q = c.heat_flux[rows] * tau[rows]                   # heat heat/gran moved into i [J]
-        np.subtract.at(atoms.T, i, q / self.loop.C[i])
-        np.add.at(atoms.T, j, q / self.loop.C[j])
-        self.totals["heat_gran_undone"] += float(np.abs(q).sum())
-
     def flush_events(self) -> None:
         """The contact events recorded since the last harvest, taken now (a run stopped
         between harvests: its checkpoint and summary hold every collision)."""
-        if self.events and self.loop.ready and (self.dem.events.waiting or self.dem.events.window):
+        if self.loop.ready and (self.dem.events.waiting or self.dem.events.window):
             atoms = self.dem.atoms(self.loop.heat)
             self.loop.track_particles(atoms)
             self.harvest(atoms, final=True)

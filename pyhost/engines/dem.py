@@ -4,9 +4,8 @@ generates from the scene (``pyhost.dem_input``). Both go through the same class.
 
 What the coupling loop gets from it, each in LIGGGHTS' local order and valid until the next
 ``run``: ``atoms()`` (ids, positions, velocities, radii, masses, types and the writable
-``Temp`` of every particle) and ``contacts()`` (every particle-particle and particle-wall
-contact, from LIGGGHTS' own ``compute pair/gran/local`` and ``wall/gran/local``, and from the
-geometry of primitive walls, which LIGGGHTS does not list). Temperatures live in LIGGGHTS'
+``Temp`` of every particle) and ``events`` (the contacts begun and ended at every step,
+recorded inside LIGGGHTS: ``pyhost.engines.events``). Temperatures live in LIGGGHTS'
 per-atom ``Temp`` (the property ``fix heat/gran`` uses), so a script's dumps, restarts and
 fixes see them. What the host adds to a script it prints once, before the first run.
 
@@ -25,18 +24,15 @@ from pathlib import Path
 import numpy as np
 
 from pyhost.collisions import WALL_BASE
-from pyhost.contacts import Contacts
-from pyhost.walls import plane_of, primitive_overlap
+from pyhost.walls import plane_of
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
 from pyhost.engines.events import RECORDED
 from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_values, put_by_id, set_random_states, write_local)
-from pyhost.script import Command, ScriptError, ScriptInfo, local_columns
+from pyhost.script import Command, ScriptError, ScriptInfo
 
 FLUID_FIX = "collheat_fluid"
-PAIR_COMPUTE, WALL_COMPUTE = "collheat_pairs", "collheat_walls"
-NEEDED = ("pos", "vel", "id")
 HEAT_GRAN_WINDOW = 200
 """DEM steps of a fix heat/gran's flux the event recorder keeps per new pair contact: what
 heat/gran moved during a collision's model duration t_coll is taken back from them, so
@@ -76,11 +72,7 @@ class Dem:
         self.lmp = Liggghts(Path(workdir).resolve(), variables=variables, comm=link and link.comm)
         self.info = ScriptInfo()
         self.log = log
-        self.pair_cols = self.wall_cols = None
-        self._warned_mesh = False
         self.events = None        # the contact event recorder (pyhost.engines.events), if asked for
-        self._mesh_events = False  # the recorder takes the mesh walls too
-        self._warned_mesh_events = False
         self._warnings = set()    # LIGGGHTS warnings already shown
         self._pending = None      # under MPI: the last gathered atoms, their T and v as gathered
         self._counts = None       # under MPI: atoms per rank in the last gather
@@ -110,7 +102,6 @@ class Dem:
     def command(self, cmd: Command) -> None:
         """Run one script command; a refusal names the script's file and line."""
         try:
-            self._before(cmd)
             self._raw(cmd.text)
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()}: {exc}") from None
@@ -122,16 +113,6 @@ class Dem:
         is otherwise tried alone): see ``Liggghts.try_ahead``."""
         if self.link is None:
             self.lmp.try_ahead([c.text for c in cmds])
-
-    def _before(self, cmd: Command) -> None:
-        """What the host added that a valid script command would trip on: LIGGGHTS refuses
-        to unfix a mesh wall while a compute wall/gran/local is active, so the host's goes
-        first (the script's own would stop plain LIGGGHTS too, and stays)."""
-        w = cmd.words
-        if (w[0] == "unfix" and len(w) == 2 and self.info.wall_compute is not None
-                and self.info.wall_compute[0] == WALL_COMPUTE and getattr(self.info.walls.get(w[1]), "meshes", None)):
-            self._raw(f"uncompute {WALL_COMPUTE}")
-            self.info.wall_compute = None
 
     def context(self, cmd: Command) -> None:
         """The script command under way, on every rank: named if LIGGGHTS ends the process
@@ -176,43 +157,28 @@ class Dem:
             raise ScriptError(f"run {steps}{' upto' if upto else ''}: {why} (LIGGGHTS: 'Invalid run command')")
         return n
 
-    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
-                events: bool = False) -> list[str]:
+    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False) -> list[str]:
         """What the host adds before the first run: the Temp property (if no fix heat/gran or
-        property/atom Temp made it), the contact computes the script lacks (with ``events``, the
-        contact event recorder in place of the pair compute), and the fluid force.
-        ``contacts``: whether the loop samples contacts (default: with heat). Returns the
+        property/atom Temp made it), the contact event recorder's fix and the fluid force.
+        ``contacts``: whether the loop needs the contacts (default: with heat). Returns the
         added commands (printed once)."""
         from pyhost.engines.events import fix_command
 
         contacts = heat if contacts is None else contacts
-        events = events and contacts
         added = []
         if heat and not self.info.temp_fix and not self.info.heat_gran:
             added.append("fix Temp all property/atom Temp scalar yes yes no 0.0")
-        if events:
+        if contacts:
             added.append(fix_command())
-        if contacts and not events and self.info.pair_compute is None:
-            keys = "pos vel id delta" + (" heatFlux" if self.info.heat_gran else "")
-            added.append(f"compute {PAIR_COMPUTE} all pair/gran/local {keys}")
-        if contacts and self.info.wall_compute is None and any(w.meshes for w in self.info.walls.values()):
-            added.append(f"compute {WALL_COMPUTE} all wall/gran/local pos vel id delta")
         if fluid_force:
             added.append(f"fix {FLUID_FIX} all external pf/array 1")
         for line in added:
             self.command(Command(line, "(host)", 0))
-        if events:
+        if contacts:
             from pyhost.engines.events import ContactEvents, RankEvents
             self.events = ContactEvents(self.lmp) if self.link is None else RankEvents(self.lmp, self.link)
             if heat and self.info.heat_gran:
                 self.events.conduction(self.info.heat_gran, HEAT_GRAN_WINDOW)
-        for which in ("pair_compute", "wall_compute"):
-            found = getattr(self.info, which)
-            if found and found[0] not in (PAIR_COMPUTE, WALL_COMPUTE):
-                missing = [k for k in NEEDED if k not in (found[1] or NEEDED)]
-                if missing:
-                    raise ScriptError(f"the script's compute {found[0]} lacks the keyword(s) {' '.join(missing)} "
-                                      "the host needs: add them (LIGGGHTS allows one such compute)")
         self.run(0)
         if fluid_force:         # the set-up added fix external's array while it was uninitialised
             self.set_force(np.zeros((self.count(), 3)))     # memory: zero it and set up again
@@ -408,22 +374,20 @@ class Dem:
         return fix
 
     def has_heat_flux(self) -> bool:
-        """Whether heat/gran's flux through each contact reaches the host: the pair contact
-        compute's heatFlux column, or the event recorder's flux histories."""
-        if self.events is not None:
-            return self.events.window > 0
-        return self.info.pair_compute is not None and "heatFlux" in self.info.pair_compute[1]
+        """Whether heat/gran's flux through each contact reaches the host (the event
+        recorder's flux histories)."""
+        return self.events is not None and self.events.window > 0
 
     # -- contacts ---------------------------------------------------------------------
-    def sampled_walls(self) -> bool:
-        """Whether some wall's contacts must still be sampled beside the event recorder (mesh
-        walls it could not take, primitive kinds it does not know)."""
-        return any((w.meshes and not self._mesh_events) or (w.primitive is not None and w.primitive[0] not in RECORDED)
-                   for w in self.info.walls.values())
-
     def event_planes(self, wall_index: dict) -> None:
         """The primitive plane, cylinder and mesh walls, for the event recorder, with their
         contact codes."""
+        unknown = [f"{fix} ({w.primitive[0]})" for fix, w in self.info.walls.items()
+                   if w.primitive is not None and w.primitive[0] not in RECORDED]
+        if unknown:
+            raise ScriptError(f"fix wall/gran {', '.join(unknown)}: a primitive wall kind the contact recorder "
+                              f"does not know (it records {', '.join(sorted(RECORDED))}): its collisions "
+                              "cannot be seen")
         primitive = [(w.primitive, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items()
                      if w.primitive is not None]
         planes = [(*plane_of(p), code) for p, code in primitive if plane_of(p)]
@@ -433,93 +397,8 @@ class Dem:
         self.events.cylinders(*(zip(*cylinders) if cylinders else ([], [], [], [], [])))
         meshes = [(mesh, WALL_BASE + wall_index[fix, k]) for fix, w in self.info.walls.items()
                   for k, mesh in enumerate(w.meshes or ())]
-        self._mesh_events = self.events.meshes(*(zip(*meshes) if meshes else ([], [])))
-        if not self._mesh_events and not self._warned_mesh_events:
-            self._warned_mesh_events = True
-            self.log("note: a mesh wall has no neighbour list the event recorder can use: its contacts are sampled")
-
-    def contacts(self, atoms: Atoms, wall_index: dict) -> Contacts:
-        """Every contact now (see :class:`Contacts`); with the event recorder, only those it
-        does not record: mesh walls without a neighbour list, primitive kinds not in RECORDED. ``wall_index``: host wall index of each
-        (wall/gran fix id, mesh index in the fix); a particle touching several triangles of one
-        mesh is one contact (the deepest)."""
-        events = self.events is not None
-        parts = [] if events else [self._pair_contacts(atoms)]
-        for fix, wall in self.info.walls.items():
-            if wall.primitive is not None and not (events and wall.primitive[0] in RECORDED):
-                parts.append(_primitive_contacts(atoms, wall.primitive, WALL_BASE + wall_index[fix, 0]))
-        mesh_fixes = [f for f, w in self.info.walls.items() if w.meshes and not (events and self._mesh_events)]
-        if mesh_fixes and self.info.wall_compute is None:
-            if not self._warned_mesh:
-                self._warned_mesh = True
-                self.log(f"warning: mesh wall fix {mesh_fixes[-1]!r} came after the first run, when LIGGGHTS no "
-                         "longer takes a compute wall/gran/local: its collisions are not seen")
-        elif mesh_fixes:
-            fix = mesh_fixes[-1]
-            codes = [WALL_BASE + wall_index[fix, k] for k in range(len(self.info.walls[fix].meshes))]
-            parts.append(self._mesh_contacts(atoms, np.array(codes, np.int64)))
-        return Contacts.concat(parts)
-
-    @collective
-    def _local(self, which: str):
-        compute_id, keywords = getattr(self.info, which)
-        if self.link is None:
-            a = self.lmp.local_array(compute_id)
-        else:
-            self._order("local", compute_id)
-            a = gather_arrays(self.link.comm, [self.lmp.local_array(compute_id)])[0][0]
-        cols_attr = "pair_cols" if which == "pair_compute" else "wall_cols"
-        if getattr(self, cols_attr) is None:
-            setattr(self, cols_attr, local_columns(keywords, a.shape[1]))
-        return a, getattr(self, cols_attr)
-
-    def _pair_contacts(self, atoms: Atoms) -> Contacts:
-        a, c = self._local("pair_compute")
-        xi, xj = a[:, c["pos"]][:, :3], a[:, c["pos"]][:, 3:]
-        d = xi - xj
-        lo, hi, periodic = self.box()
-        length = hi - lo
-        d = np.where(periodic, d - length * np.round(d / length), d)    # positions come remapped
-        dist = np.linalg.norm(d, axis=1)
-        n = d / np.where(dist > 0, dist, 1.0)[:, None]
-        ids = a[:, c["id"]]
-        # the owners' velocities: a ghost partner (another rank's atom, or a periodic image)
-        # carries the half-step velocity LIGGGHTS communicated before its final integration
-        at = atoms.index(ids[:, :2].astype(np.int64))
-        vi, vj = atoms.v[at[:, 0]], atoms.v[at[:, 1]]
-        if "delta" in c:
-            delta = a[:, c["delta"]][:, 0]
-        else:
-            r = atoms.radius[at]
-            delta = r.sum(axis=1) - dist
-        flux = a[:, c["heatFlux"]][:, 0] if "heatFlux" in c else np.zeros(len(a))
-        # i the smaller id: LIGGGHTS lists a pair either way round (by its local order, or on
-        # the rank owning the larger id), and the collision rows should not depend on that
-        i, j = ids[:, 0].astype(np.int64), ids[:, 1].astype(np.int64)
-        s = np.where(i < j, 1.0, -1.0)
-        return Contacts(np.minimum(i, j), np.maximum(i, j), delta, n * s[:, None],
-                        -np.einsum("ij,ij->i", vi - vj, n), flux * s)
-
-    def _mesh_contacts(self, atoms: Atoms, codes: np.ndarray) -> Contacts:
-        a, c = self._local("wall_compute")
-        cp, xp = a[:, c["pos"]][:, :3], a[:, c["pos"]][:, 3:]
-        vw, vp = a[:, c["vel"]][:, :3], a[:, c["vel"]][:, 3:]
-        pid = a[:, c["id"]][:, 2].astype(np.int64)
-        wall = codes[a[:, c["id"]][:, 0].astype(np.int64)]
-        d = xp - cp
-        dist = np.linalg.norm(d, axis=1)
-        n = d / np.where(dist > 0, dist, 1.0)[:, None]
-        delta = a[:, c["delta"]][:, 0] if "delta" in c else atoms.radius[atoms.index(pid)] - dist
-        order = np.lexsort((-delta, wall, pid))        # deepest triangle of each particle and mesh first
-        new = np.r_[True, (pid[order][1:] != pid[order][:-1]) | (wall[order][1:] != wall[order][:-1])]
-        first = order[new] if len(pid) else order
-        return Contacts(pid[first], wall[first], delta[first], n[first],
-                        -np.einsum("ij,ij->i", vp[first] - vw[first], n[first]), np.zeros(len(first)))
-
-
-def _primitive_contacts(atoms: Atoms, primitive, wall: int) -> Contacts:
-    """Contacts with a fixed primitive wall (``pyhost.walls.primitive_overlap``)."""
-    delta, normal = primitive_overlap(atoms.x, atoms.radius, primitive)
-    on = np.flatnonzero(delta > 0)
-    return Contacts(atoms.id[on], np.full(len(on), wall, np.int64), delta[on], normal[on],
-                    -np.einsum("ij,ij->i", atoms.v[on], normal[on]), np.zeros(len(on)))
+        if not self.events.meshes(*(zip(*meshes) if meshes else ([], []))):
+            names = ", ".join(sorted({m for m, _ in meshes}))
+            raise ScriptError(f"the mesh walls {names}: the contact recorder finds no neighbour list of a fix "
+                              "wall/gran on them (every fix wall/gran of LIGGGHTS 3.8 makes one): their "
+                              "collisions cannot be seen")

@@ -42,8 +42,8 @@ def fix_command(fix: str = FIX) -> str:
 
 RECORDED = frozenset({"xplane", "yplane", "zplane", "xcylinder", "ycylinder", "zcylinder"})
 """The primitive wall kinds (``pyhost.walls.PRIMITIVES``) whose contacts the recorder notes
-(``planes``, ``cylinders``; plugins/liggghts/contact_events.cpp). A kind of pyhost.walls that
-is not here has its contacts sampled from its geometry beside the recorder."""
+(``planes``, ``cylinders``; plugins/liggghts/contact_events.cpp): all six of LIGGGHTS 3.8. A
+wall of a kind not here is refused (``Dem.event_planes``): its collisions would go unseen."""
 ROW = 12
 BEGIN, END = 0, 1
 EVENT = np.dtype([("kind", np.int8), ("wall", np.bool_), ("step", np.int64), ("i", np.int64), ("j", np.int64),

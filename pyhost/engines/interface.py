@@ -4,9 +4,8 @@ LAMMPS' GRANULAR package, LIGGGHTS' maintained successor, is the likely next one
 
 The engine runs a script command by command (the host's commands among them), advances in
 chunks of steps, and hands out the particles (``Atoms``) with writable temperatures. Contacts
-come either as events recorded inside the engine at every step (``events``: the recorder of
-``pyhost.engines.events``) or, without a recorder, as lists sampled between chunks
-(``contacts``). SI units throughout. ``tests/unit/test_structure.py`` checks that the loop and
+come as events recorded inside the engine at every step (``events``: the recorder of
+``pyhost.engines.events``). SI units throughout. ``tests/unit/test_structure.py`` checks that the loop and
 the effects use nothing of the engine outside this interface, and that ``Dem`` has all of it.
 """
 from __future__ import annotations
@@ -21,7 +20,7 @@ class DemEngine(Protocol):
 
     # -- state -------------------------------------------------------------------------
     info: object                 # what the script declared so far (pyhost.script.ScriptInfo): walls, heat/gran, computes
-    events: object | None        # the contact event recorder (pyhost.engines.events), None: contacts are sampled
+    events: object | None        # the contact event recorder (pyhost.engines.events), None: no contacts asked for
     link: object | None          # the other MPI ranks (pyhost.engines.ranks.Link), None when serial
 
     @property
@@ -46,10 +45,9 @@ class DemEngine(Protocol):
     def engine_command(self, line: str) -> None:
         """Run a command of the host's own (write_restart, ...)."""
 
-    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
-                events: bool = False) -> list[str]:
-        """Before the first run: add what the host needs (temperatures, contact computes or the
-        event recorder, the external force); returns the commands added, for the log."""
+    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False) -> list[str]:
+        """Before the first run: add what the host needs (temperatures, the contact event
+        recorder, the external force); returns the commands added, for the log."""
 
     def steps(self, steps: str, upto: bool) -> int:
         """The number of steps of a script's ``run N [upto]``."""
@@ -106,12 +104,6 @@ class DemEngine(Protocol):
     # -- contacts ----------------------------------------------------------------------
     def event_planes(self, wall_index: dict) -> None:
         """Hand the recorder the walls it records contacts with, by their host codes."""
-
-    def sampled_walls(self) -> bool:
-        """Whether some wall's contacts must still be sampled beside the recorder."""
-
-    def contacts(self, atoms, wall_index: dict):
-        """The contacts now (``pyhost.contacts.Contacts``), those the recorder does not take."""
 
     # -- what a checkpoint keeps that the engine's restart does not ------------------------
     def mesh_motion_times(self) -> dict:

@@ -98,8 +98,8 @@ def _declare(lib: ctypes.CDLL, table: dict) -> None:
 @dataclass(frozen=True)
 class ComputeRows:
     """A contact compute's rows now, one contact each (all SI): the raw probe of LIGGGHTS'
-    ``pair/gran/local`` and ``wall/gran/local`` that the engine tests and benchmarks read; the
-    host's contact lists are ``pyhost.contacts.Contacts``, from ``pyhost.engines.dem.Dem``.
+    ``pair/gran/local`` and ``wall/gran/local`` that the engine tests and benchmarks read (runs
+    take contacts from the event recorder, ``pyhost.engines.events``).
 
     ``i``, ``j``: atom ids (for a wall contact ``j`` is the wall's index); ``delta``: normal
     overlap (m); ``vi``, ``vj``: velocities of the two (m/s; ``vj`` is the wall's), so the

@@ -4,11 +4,11 @@ LIGGGHTS decomposes its domain over all N ranks (one LIGGGHTS on ``MPI.COMM_WORL
 through mpi4py). The host itself (scene, loop, plugin, output, the fluid solver's link) runs
 on rank 0 only. The other ranks *follow*: they wait for rank 0's next order and make the same
 collective LIGGGHTS call (a command, a run, a variable), or hand their local atoms and contact
-rows to rank 0 (``gather``) and take back their own slice of what the host changed
-(temperatures, velocities, fluid forces: ``scatter``, in the local order they sent). So every
-collision is seen once, on rank 0, from LIGGGHTS' own contact lists (``compute
-pair/gran/local`` lists a pair that spans two ranks once, on the rank owning the atom of
-the larger id), and the total m c T is summed over all ranks' atoms.
+events to rank 0 (``gather``) and take back their own slice of what the host changed
+(temperatures, velocities, fluid forces: ``scatter``, in the local order they sent). Every
+collision is recorded once, by the rank owning the atom of the smaller id (a wall contact:
+the particle's owner; ``pyhost.engines.events``), and the total m c T is summed over all
+ranks' atoms.
 
 Orders are ``(name, args)`` tuples broadcast from rank 0 (mpi4py's pickled ``bcast``); each
 name is one method of :class:`Follower`. Nothing here is a parallel algorithm of ours: the
@@ -227,9 +227,6 @@ class Follower:
 
     def do_count(self) -> None:
         self.comm.gather(self.lmp.nlocal, root=ROOT)
-
-    def do_local(self, compute_id) -> None:
-        gather_arrays(self.comm, [self.lmp.local_array(compute_id)])
 
     def do_per_atom(self, names) -> None:
         self.comm.gather(local_values(self.lmp, names), root=ROOT)

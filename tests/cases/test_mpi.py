@@ -35,7 +35,7 @@ def grid(out):
     return None
 
 
-def pair_across_the_boundary(tmp_path, contacts):
+def pair_across_the_boundary(tmp_path):
     """two-particles with its spheres on either side of x = 0.05 m, where LIGGGHTS cuts the
     0.1 m long box between its two ranks."""
     case = tmp_path / "case"
@@ -43,26 +43,11 @@ def pair_across_the_boundary(tmp_path, contacts):
     toml = case / "case.toml"
     text = toml.read_text()
     for old, new in (("[[0.045, 0.005, 0.01]]", "[[0.0478, 0.005, 0.01]]"),
-                     ("[[0.0492, 0.005, 0.01]]", "[[0.0522, 0.005, 0.01]]"),
-                     ("[time]\n", f'[time]\ncontacts = "{contacts}"\n')):
+                     ("[[0.0492, 0.005, 0.01]]", "[[0.0522, 0.005, 0.01]]")):
         assert old in text
         text = text.replace(old, new)
     toml.write_text(text)
     return case
-
-
-def test_two_particles_across_the_rank_boundary_equal_the_serial_run(tmp_path):
-    """The collision is a pair of a local and a ghost atom on each rank. Sampled contacts
-    (``contacts = "samples"``, gathered to rank 0): collision rows, history and summary are
-    the serial run's, bit for bit."""
-    case = pair_across_the_boundary(tmp_path, "samples")
-    serial = run(case, tmp_path / "np1", 1)
-    parallel = run(case, tmp_path / "np2", 2)
-    assert grid(tmp_path / "np2") == "2 by 1 by 1"
-    assert serial["collisions"] == 1
-    assert parallel == serial
-    for name in ("collisions.csv", "history.csv"):
-        assert (tmp_path / "np2" / name).read_bytes() == (tmp_path / "np1" / name).read_bytes(), name
 
 
 def test_contact_events_of_a_pair_across_the_rank_boundary_equal_the_serial_run(tmp_path):
@@ -71,7 +56,7 @@ def test_contact_events_of_a_pair_across_the_rank_boundary_equal_the_serial_run(
     history are the serial run's bit for bit. Restitution feedback: the recorder changes only
     its own rank's atoms, so the separation speed e v0 of a pair on two ranks is imposed by the
     host at the harvest after the end (restitution_late, 1 here) instead of at the end's step."""
-    case = pair_across_the_boundary(tmp_path, "events")
+    case = pair_across_the_boundary(tmp_path)
     serial = run(case, tmp_path / "np1", 1)
     parallel = run(case, tmp_path / "np2", 2)
     assert grid(tmp_path / "np2") == "2 by 1 by 1"
@@ -84,8 +69,8 @@ def test_contact_events_of_a_pair_across_the_rank_boundary_equal_the_serial_run(
 
 def test_granular_gas_on_two_ranks(tmp_path):
     """hot-cold-box's smoke run (1000 spheres, periodic): the same collisions within the
-    chaos of the gas (the order of each sample's contacts differs, so rounding does), and
-    the heat balance to rounding on two ranks."""
+    chaos of the gas (the order of the force sums differs, so rounding does), and the heat
+    balance to rounding on two ranks."""
     serial = run(CASES / "hot-cold-box", tmp_path / "np1", 1, "--test")
     parallel = run(CASES / "hot-cold-box", tmp_path / "np2", 2, "--test")
     assert grid(tmp_path / "np2") is not None and grid(tmp_path / "np2") != "1 by 1 by 1"
@@ -100,30 +85,27 @@ def test_granular_gas_on_two_ranks(tmp_path):
 
 
 
-def test_poured_silo_on_two_ranks_events_agree_with_samples(tmp_path):
+def test_poured_silo_on_two_ranks(tmp_path):
     """silo-heat --test (900 spheres poured into an STL tube onto a shaken plate, fix
-    heat/gran) on two ranks split across z, once on contact events (each rank records its
-    own) and once on samples (gathered to rank 0). Settling spheres keep their contacts while
-    they cross the ranks' boundary: those contacts end on one rank and begin on the other at a
-    neighbour build, and are joined into one (contacts_changed_rank, 5 measured). Measured:
-    7,237 against 7,234 collisions, heat 0.14 % apart; asserted 1 % each, and the balance."""
-    runs = {}
-    for contacts in ("events", "samples"):
-        case = tmp_path / contacts
-        shutil.copytree(CASES / "silo-heat", case, ignore=shutil.ignore_patterns("output", "post"))
-        toml = case / "case.toml"
-        text = toml.read_text().replace("[time]\n", f'[time]\ncontacts = "{contacts}"\n', 1)
-        toml.write_text(text + "pictures = false\n")
-        runs[contacts] = run(case, tmp_path / f"out-{contacts}", 2, "--test")
-    assert grid(tmp_path / "out-events") == "1 by 1 by 2"
-    events, samples = runs["events"], runs["samples"]
-    for r in (events, samples):
-        assert r["status"] == "completed" and r["inserted"] == 900
-        assert abs(r["energy_balance_error"]) < 1e-12
-    assert events.get("contacts_changed_rank", 0) > 0
-    assert events["collisions"] == pytest.approx(samples["collisions"], rel=0.01)
-    assert events["particle_wall"] == pytest.approx(samples["particle_wall"], rel=0.01)
-    assert events["heat_moved"] == pytest.approx(samples["heat_moved"], rel=0.01)
+    heat/gran) on two ranks split across z, each rank recording its own contacts. Settling
+    spheres keep their contacts while they cross the ranks' boundary: those contacts end on one
+    rank and begin on the other at a neighbour build, and are joined into one
+    (contacts_changed_rank, 5 measured). One left unjoined would begin a second time while
+    resting, without closing in (contacts_without_impact). Measured: 3 such, each an atom
+    inserted (steps 4001 and 8001) onto another: LIGGGHTS' insertion on two ranks places a few
+    particles overlapping; asserted at most 5. The balance closes to 1e-12. (The pour itself
+    depends on the cut: 7,237 collisions on two ranks against 7,794 serially, measured; on two
+    ranks the samples of session 32 gave 7,234.)"""
+    case = tmp_path / "silo"
+    shutil.copytree(CASES / "silo-heat", case, ignore=shutil.ignore_patterns("output", "post"))
+    (case / "case.toml").write_text((case / "case.toml").read_text() + "pictures = false\n")
+    r = run(case, tmp_path / "out", 2, "--test")
+    print({k: r.get(k) for k in ("collisions", "particle_wall", "heat_moved", "contacts_changed_rank")})
+    assert grid(tmp_path / "out") == "1 by 1 by 2"
+    assert r["status"] == "completed" and r["inserted"] == 900
+    assert r["collisions"] > 5000 and r["particle_wall"] > 1000
+    assert r.get("contacts_changed_rank", 0) > 0 and r.get("contacts_without_impact", 0) <= 5
+    assert abs(r["energy_balance_error"]) < 1e-12
 
 
 # conftest's pour without heat/gran, dumps or computes, 300 spheres
@@ -152,12 +134,12 @@ def test_harvests_between_frames_gather_only_the_colliding_atoms(tmp_path):
     """A user's pour (300 spheres of two sizes onto an STL floor, hot type 1 and cold type 2,
     no fix heat/gran) on two ranks, a frame only at the end: rank 0's harvests every 1,000
     steps gather the atoms of their events only (Dem.atoms_of), not every atom. Against the
-    same run on samples (every atom and contact gathered every 5 steps): the same contacts,
-    collisions plus contacts without impact equal, the same particles, and each balance to
-    1e-12; heat moved within 1 % (impact speeds at touch against integrated back)."""
+    same run with a frame at every harvest (every atom gathered then): the same pour (the
+    host changes no velocity here), so the same collisions, contacts without impact and
+    particles, heat moved to 1e-12 and each balance to 1e-12."""
     out = {}
-    for contacts in ("events", "samples"):
-        case = tmp_path / contacts
+    for every in (1.0, 0.01):           # 0.01 s = 1,000 steps: a frame at each harvest
+        case = tmp_path / f"every{every}"
         case.mkdir()
         (case / "floor.stl").write_text(FLOOR_STL)
         (case / "in.pour").write_text(POUR)
@@ -165,10 +147,8 @@ def test_harvests_between_frames_gather_only_the_colliding_atoms(tmp_path):
 script = "in.pour"
 [effects]
 contact_heat = "A"
-{glass_toml("hot", "[1]", "temperature = 400.0")}{glass_toml("cold", "[2]", "temperature = 300.0")}[time]
-contacts = "{contacts}"
-[output]
-every = 1.0
+{glass_toml("hot", "[1]", "temperature = 400.0")}{glass_toml("cold", "[2]", "temperature = 300.0")}[output]
+every = {every}
 vtk = false
 pictures = false
 """)
@@ -176,17 +156,19 @@ pictures = false
                             str(case), "--out", str(case / "out")], capture_output=True, text=True, env=ENV,
                            timeout=600)
         assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-        out[contacts] = json.loads((case / "out" / "summary.json").read_text())
-        out[contacts]["atoms_of"] = int(r.stdout.rsplit("atoms_of calls: ", 1)[1].split()[0])
-    events, samples = out["events"], out["samples"]
-    assert grid(tmp_path / "events" / "out") != "1 by 1 by 1"
-    assert events["atoms_of"] >= 5 and samples["atoms_of"] == 0
-    assert events["inserted"] == samples["inserted"] == 300
-    assert events["collisions"] + events.get("contacts_without_impact", 0) == samples["collisions"]
-    assert events["particle_wall"] + events.get("contacts_without_impact", 0) == samples["particle_wall"]
-    for r in (events, samples):
+        out[every] = json.loads((case / "out" / "summary.json").read_text())
+        out[every]["atoms_of"] = int(r.stdout.rsplit("atoms_of calls: ", 1)[1].split()[0])
+    partly, whole = out[1.0], out[0.01]
+    print({k: (partly.get(k), whole.get(k)) for k in ("atoms_of", "collisions", "particle_wall",
+                                                      "contacts_without_impact", "heat_moved")})
+    assert grid(tmp_path / "every1.0" / "out") != "1 by 1 by 1"
+    assert partly["atoms_of"] >= 5 and whole["atoms_of"] == 0
+    assert partly["inserted"] == whole["inserted"] == 300
+    for key in ("collisions", "particle_wall", "contacts_without_impact"):
+        assert partly.get(key, 0) == whole.get(key, 0), key
+    for r in (partly, whole):
         assert r["status"] == "completed" and abs(r["energy_balance_error"]) < 1e-12
-    assert events["heat_moved"] == pytest.approx(samples["heat_moved"], rel=0.01)
+    assert partly["heat_moved"] == pytest.approx(whole["heat_moved"], rel=1e-12)
 
 
 def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):

@@ -147,6 +147,7 @@ SCENES = {   # id: (change, words the one-line message must hold)
     "fluid ranks above the cells across": (fluid(cells=[4, 1, 8], ranks=5), ["fluid.ranks = 5", "only 4 cells there"]),
     "missing time": (remove(("time",)), ["time", "missing"]),
     "sample_every zero": (setter(("time", "sample_every"), 0), ["time.sample_every"]),
+    "contacts sampled (retired)": (setter(("time", "contacts"), "samples"), ["time.contacts", "retired"]),
     "wall temperature negative": (setter(("walls",), [dict(plane="zlo", material="steel", temperature=-1.0)]),
                                   ["walls[0].temperature"]),
     "wall plane unknown": (setter(("walls",), [dict(plane="top", material="steel")]), ["walls[0].plane"]),

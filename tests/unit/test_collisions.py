@@ -1,4 +1,5 @@
-"""The host's collision logic without engines: impact speed, contact tracking, heat exchange."""
+"""The host's collision logic without engines: impact speed (post's back-integration), contact
+keys, heat exchange."""
 
 import numpy as np
 import pytest
@@ -6,7 +7,7 @@ from scipy.integrate import solve_ivp
 
 from plugins.heat.exchange import exchange_heat
 from plugins.dem.hertz import DemHertz
-from pyhost.collisions import WALL_BASE, ContactTracker, contact_keys
+from pyhost.collisions import WALL_BASE, contact_keys
 
 LAW = DemHertz(Ystar=5e7, e=0.8)          # a softened DEM contact
 R, M = 1e-3, 2e-5                          # effective radius [m] and mass [kg]
@@ -55,38 +56,6 @@ def test_contact_keys_order_free_and_walls_distinct():
     assert contact_keys(3, WALL_BASE) != contact_keys(3, 7)
     with pytest.raises(ValueError):
         contact_keys(-1, 2)
-
-
-def test_tracker_reports_opened_and_closed():
-    tr = ContactTracker()
-    a, b, c = contact_keys([1, 2, 3], [2, 3, WALL_BASE])
-    opened, closed = tr.update(np.array([a, b]))
-    assert list(opened) == [0, 1] and closed.size == 0
-    opened, closed = tr.update(np.array([b, c]))
-    assert list(opened) == [1] and list(closed) == [a]
-    opened, closed = tr.update(np.array([], np.int64))
-    assert opened.size == 0 and sorted(closed) == sorted([b, c])
-    with pytest.raises(ValueError, match="twice"):
-        tr.update(np.array([a, a]))
-
-
-def test_tracker_match_gives_each_contacts_place_in_the_last_sample():
-    """match(): for every key its index in the last open_keys (-1: new), and the indices of
-    the closed ones there, so per-contact arrays can follow the keys; against a dict. Opened
-    and closed come in key order whatever the order of the list (the engine's follows the
-    atoms' order in memory, which a restart changes)."""
-    rng = np.random.default_rng(5)
-    tr, last = ContactTracker(), np.empty(0, np.int64)
-    for _ in range(20):
-        keys = rng.permutation(np.unique(rng.integers(0, 60, 40)))[:30].astype(np.int64)
-        opened, closed, prev = tr.match(keys)
-        where = {k: n for n, k in enumerate(last.tolist())}
-        assert prev.tolist() == [where.get(k, -1) for k in keys.tolist()]
-        assert sorted(opened.tolist()) == [n for n, k in enumerate(keys.tolist()) if k not in where]
-        assert np.all(np.diff(keys[opened]) > 0)
-        assert last[closed].tolist() == sorted(k for k in last.tolist() if k not in set(keys.tolist()))
-        assert tr.open_keys.tolist() == keys.tolist()
-        last = keys
 
 
 def test_heat_exchange_conserves_and_caps():

@@ -92,24 +92,20 @@ def test_cylinder_wall_inside_and_outside():
     assert c.delta[k] == pytest.approx(0.02) and np.allclose(c.normal[k], [0, -1, 0]) and c.approach[k] == pytest.approx(1.0)
 
 
-def test_a_primitive_wall_kind_the_recorder_does_not_know_is_sampled(monkeypatch):
-    """With contact events on, Dem.contacts leaves the primitive walls to the recorder only for
-    the kinds it records (pyhost.engines.events.RECORDED); a kind pyhost.walls knows and the
-    recorder does not is taken from its geometry beside it (and makes the loop sample), so a
-    new wall kind in pyhost/walls.py is seen before the compiled recorder learns it."""
-    from types import SimpleNamespace
-
+def test_every_primitive_wall_kind_is_recorded_and_an_unrecorded_one_is_refused(monkeypatch):
+    """Runs see walls only through the contact recorder: every kind pyhost.walls reads
+    (LIGGGHTS 3.8's six primitives) is one it records, and a kind it does not record is a
+    ScriptError naming the wall, not a wall whose collisions go unseen."""
     from pyhost.engines import dem as dem_module
     from pyhost.engines.dem import Dem
-    from pyhost.script import GranWall, ScriptInfo
+    from pyhost.engines.events import RECORDED
+    from pyhost.script import GranWall, ScriptError, ScriptInfo
+    from pyhost.walls import PRIMITIVES
 
+    assert RECORDED == set(PRIMITIVES)
     d = Dem.__new__(Dem)
-    d.info, d.events, d._mesh_events = ScriptInfo(), object(), True
+    d.info = ScriptInfo()
     d.info.walls["floor"] = GranWall("floor", primitive=("zplane", (0.0,)), type=1)
-    atoms = SimpleNamespace(x=np.array([[0.5, 0.5, 0.05], [0.5, 0.5, 0.5]]), v=np.array([[0, 0, -1.0], [0, 0, 0]]),
-                            radius=np.full(2, 0.1), id=np.array([7, 8]))
-    assert len(d.contacts(atoms, {("floor", 0): 0})) == 0 and not d.sampled_walls()
     monkeypatch.setattr(dem_module, "RECORDED", frozenset({"zcylinder"}))
-    c = d.contacts(atoms, {("floor", 0): 0})
-    assert c.i.tolist() == [7] and c.j.tolist() == [WALL_BASE] and c.delta[0] == pytest.approx(0.05)
-    assert d.sampled_walls()
+    with pytest.raises(ScriptError, match="floor.*zplane"):
+        d.event_planes({("floor", 0): 0})
