@@ -17,8 +17,9 @@ FACES = ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")
 
 PRIMITIVES = {"xplane": 1, "yplane": 1, "zplane": 1, "xcylinder": 3, "ycylinder": 3, "zcylinder": 3}
 """LIGGGHTS primitive wall kinds the host reads, and how many numbers follow each: a plane's
-position; a cylinder's radius and the two coordinates of its axis (in x, y, z order without
-the axis)."""
+position; a cylinder's radius R and its axis' coordinates c1 c2 along the axes that follow its
+own cyclically (LIGGGHTS' primitive_wall_definitions.h): y z for xcylinder, z x for ycylinder
+(not x z), x y for zcylinder."""
 
 
 def face_axis(face: str) -> tuple[int, bool]:
@@ -62,16 +63,10 @@ def primitive_overlap(x, r, primitive) -> tuple[np.ndarray, np.ndarray]:
         s = x[:, axis] - num[0]
         normal[:, axis] = np.where(s >= 0, 1.0, -1.0)
         return r - np.abs(s), normal
-    other = [k for k in range(3) if k != axis]
+    other = [(axis + 1) % 3, (axis + 2) % 3]          # c1, c2 as LIGGGHTS reads them
     rad = x[:, other] - np.array(num[1:3])
     dist = np.linalg.norm(rad, axis=1)
     unit = rad / np.where(dist > 0, dist, 1.0)[:, None]
     inside = dist < num[0]
     normal[:, other] = np.where(inside[:, None], -unit, unit)
     return r - np.where(inside, num[0] - dist, dist - num[0]), normal
-
-
-def plane_of(primitive) -> tuple[int, float] | None:
-    """(axis 0-2, position [m]) of a primitive plane wall, None for another kind."""
-    kind, num = primitive
-    return ("xyz".index(kind[0]), float(num[0])) if kind in PRIMITIVES and kind.endswith("plane") else None

@@ -40,7 +40,7 @@ def pile(workdir, n: int, events: bool):
     ev = None
     if events:
         ev = ContactEvents(lg)
-        ev.planes([2], [0.0], [WALL_BASE])
+        ev.primitives(["floor"], [WALL_BASE])
     lg.run(1)
     return lg, ev
 

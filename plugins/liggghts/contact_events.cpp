@@ -3,8 +3,9 @@
 // The host adds `fix ID all external pf/callback 1 1073741824` and attaches a Recorder to it: LIGGGHTS
 // then calls record() in post_force of every step (and of each run's set-up), after the
 // forces, with x at the end of the step and v at the half step. record() walks the pair
-// style's neighbour list and the host's primitive planes and keeps the set of touching
-// pairs (overlap r_i + r_j - |x_i - x_j| > 0, LIGGGHTS' own contact test). A contact that
+// style's neighbour list, the primitive walls (with LIGGGHTS' own geometry) and the mesh walls
+// and keeps the set of touching pairs (overlap r_i + r_j - |x_i - x_j| > 0, LIGGGHTS' own
+// contact test). A contact that
 // was not there on the previous call is a BEGIN event with its approach speed
 // vn = -(v_i - v_j) . n [m/s] (n the unit normal from j to i; > 0 while closing in): at the
 // first step in contact v is still the velocity before the contact, since the half-step
@@ -50,6 +51,7 @@
 #include "update.h"
 #include "neighbor.h"
 #include "fix_mesh_surface.h"
+#include "primitive_wall.h"
 #include "fix_neighlist_mesh.h"
 #include "fix_contact_history_mesh.h"
 #include "tri_mesh.h"
@@ -59,6 +61,17 @@
 #define protected public
 #include "fix_heat_gran_conduction.h"
 #undef protected
+
+// LIGGGHTS' fix wall/gran, of which the recorder calls one method: its header needs headers
+// Debian does not ship (style_surface_model.h), so the method is declared here. Fix is the
+// class's first base, so a Fix pointer to one is a pointer to it; the method is exported by
+// libliggghts (LAMMPS_NS::FixWallGran::primitiveWall(), null for a mesh wall).
+namespace LAMMPS_NS {
+class FixWallGran : public Fix {
+public:
+    PrimitiveWall *primitiveWall();
+};
+}
 
 using namespace LAMMPS_NS;
 
@@ -83,16 +96,13 @@ struct Recorder {
     FixExternal *fix;
     bool primed = false;                       // false: the next call records contacts, no events
     std::vector<double> rows;                  // events waiting, ROW doubles each
-    std::vector<int> axis;                     // primitive planes: axis (0, 1, 2), position [m],
-    std::vector<double> position;              // and the partner code the host gives them
-    std::vector<double> code;
-    std::vector<int> cyl_axis;                 // primitive cylinders: axis, radius [m], centre in the
-    std::vector<double> cyl_radius, cyl_c1, cyl_c2, cyl_code;   // two other coordinates [m], code
+    std::vector<FixWallGran *> prims;          // primitive walls: their fix wall/gran and the partner
+    std::vector<double> prim_code;             // code the host gives their contacts
     std::vector<FixMeshSurface *> meshes;       // mesh walls: the fix mesh/surface and the code
     std::vector<double> mesh_code;             // of its contacts (one per particle and mesh: the deepest)
     std::vector<double> depth, normal;         // per local atom, this call and mesh: overlap [m] and normal,
     std::vector<int> deepest;                  // and the deepest triangle (meshes without a contact history)
-    bool new_planes = false;                   // planes given since the last call: what touches them is open
+    bool new_planes = false;                   // walls given since the last call: what touches them is open
     long long begun = 0, ended = 0;
     int meshes_by_history = 0;                 // meshes read from LIGGGHTS' contact history at the last call
     struct Target { double speed, n[3]; };     // separation speed [m/s] to impose at the end; a wall's normal
@@ -108,8 +118,8 @@ struct Recorder {
                                                // larger than all this rank saw: the host keeps the first)
 
     // The state of the contacts, laid out like the neighbour list (one slot per entry, in
-    // the order of ilist and each atom's neighbours) and, for the planes, like the local
-    // atoms (plane-major). Both layouts hold from one neighbour build to the next (LIGGGHTS
+    // the order of ilist and each atom's neighbours) and, for the walls, like the local
+    // atoms (wall-major). Both layouts hold from one neighbour build to the next (LIGGGHTS
     // sorts, exchanges, inserts and deletes atoms only before a build), so between builds a
     // step costs a distance test per neighbour and no lookup. At a build, the open contacts
     // are carried over by key.
@@ -117,22 +127,13 @@ struct Recorder {
     bigint layout_last = -1;                   // neighbor->lastcall (init() starts ncalls again),
     const NeighList *layout_list = nullptr;    // the list and its atoms
     int layout_inum = -1;
-    size_t planes_laid = 0;                    // planes and local atoms in the layout
+    size_t planes_laid = 0;                    // walls and local atoms in the layout
     int nlocal_laid = -1;
     std::vector<uint8_t> touch;                // in contact at the last call
     std::vector<bigint> since;                 // step of the first call in contact
     std::vector<uint64_t> key;                 // the contact's key
     std::vector<int> history;                  // its flux history (index into histories), or -1
     std::unordered_map<uint64_t, std::pair<bigint, int>> carry;
-    // Between two neighbour builds LIGGGHTS (neigh_modify every 1 delay 0 check yes) lets no atom
-    // move, or grow (Neighbor::check_distance with radvary_flag), by more than half the skin, so
-    // an atom farther from a primitive plane or cylinder than its radius plus the skin at a build
-    // cannot touch it before the next: each such wall is tested only against the atoms near it,
-    // listed at the build (and again whenever a radius changed, to rely on no bound for that).
-    // Other neighbour settings test every atom at every step.
-    std::vector<std::vector<int>> close_to;    // per plane, then per cylinder: local atoms near it
-    std::vector<double> close_radius;          // the radii when the lists were made
-    bool close_valid = false;
 
     void event(int kind, bigint step, double i, double j, double vn, const double *n, double duration,
                double Ti = NAN, double Tj = NAN, double imposed = 0.0)
@@ -353,32 +354,16 @@ struct Recorder {
         return me > last_wall;
     }
 
-    // Whether the plane and cylinder tests may visit only the atoms near each (``close_to``),
-    // making the lists at a build, at the first call, or when a radius changed since.
-    bool list_close(int nlocal, double **x, const double *r, bool rebuilt)
+    // Whether fix number f of LIGGGHTS comes after the recorder's (its set-up, which builds a
+    // primitive wall's list of nearby particles, then runs after the recorder's).
+    bool after_me(const Fix *f) const
     {
-        const Neighbor *nb = lmp->neighbor;
-        if (axis.empty() && cyl_axis.empty()) return false;
-        if (!(nb->every == 1 && nb->delay == 0 && nb->dist_check)) { close_valid = false; return false; }
-        const bool same_radii = close_valid && close_radius.size() == size_t(nlocal) &&
-                                (nlocal == 0 || std::memcmp(close_radius.data(), r, sizeof(double) * nlocal) == 0);
-        if (!rebuilt && same_radii) return true;
-        const double skin = nb->skin;
-        close_to.assign(axis.size() + cyl_axis.size(), std::vector<int>());
-        for (size_t w = 0; w < axis.size(); ++w)
-            for (int i = 0; i < nlocal; ++i)
-                if (std::fabs(x[i][axis[w]] - position[w]) < r[i] + skin) close_to[w].push_back(i);
-        for (size_t w = 0; w < cyl_axis.size(); ++w) {
-            const int a = cyl_axis[w], lo = std::min((a + 1) % 3, (a + 2) % 3), hi = std::max((a + 1) % 3, (a + 2) % 3);
-            for (int i = 0; i < nlocal; ++i) {
-                const double d1 = x[i][lo] - cyl_c1[w], d2 = x[i][hi] - cyl_c2[w];
-                if (std::fabs(std::sqrt(d1 * d1 + d2 * d2) - cyl_radius[w]) < r[i] + skin)
-                    close_to[axis.size() + w].push_back(i);
-            }
+        const Modify *modify = lmp->modify;
+        for (int k = 0; k < modify->nfix; ++k) {
+            if (modify->fix[k] == fix) return true;
+            if (modify->fix[k] == f) return false;
         }
-        close_radius.assign(r, r + nlocal);
-        close_valid = true;
-        return true;
+        return false;
     }
 
     void record(bigint step)
@@ -392,7 +377,7 @@ struct Recorder {
         NeighList *list = pair ? pair->list : nullptr;
         const bool have_list = list && list->ilist;
         // a new layout at each neighbour build (or new planes): the slots counted then only
-        const size_t walls = axis.size() + cyl_axis.size() + meshes.size();
+        const size_t walls = prims.size() + meshes.size();
         // (a run's set-up calls Neighbor::init, which counts builds from 0 again: the step of
         // the last build and the list itself tell a build that ncalls alone misses)
         const Neighbor *nb = lmp->neighbor;
@@ -465,43 +450,32 @@ struct Recorder {
                 }
             }
         }
-        const bool close_only = list_close(nlocal, x, r, rebuilt);
-        for (size_t w = 0; w < axis.size(); ++w, k += nlocal) {
-            const int a = axis[w];
-            auto test = [&](int i) {
+        // primitive walls (planes, cylinders), with LIGGGHTS' own geometry and list: fix wall/gran
+        // lists the particles within the skin of its wall at each neighbour build, and tests only
+        // those, and only of its group (PrimitiveWall::resolveContact: distance - radius <= 0 is a
+        // contact). Between two builds no listed particle leaves the list, and none unlisted can
+        // reach the wall (neigh_modify's check), so a contact ends while listed. delta points from
+        // the centre to the wall; the normal from the wall to the particle is -delta / |delta|.
+        for (size_t w = 0; w < prims.size(); ++w, k += nlocal) {
+            PrimitiveWall *wall = prims[w]->primitiveWall();
+            if (rebuilt && after_me(prims[w]))         // at a set-up its list is made after this call
+                wall->buildNeighList(lmp->neighbor->skin, x, atom->radius, nlocal);
+            const int groupbit = prims[w]->groupbit, *mask = atom->mask;
+            int *near = nullptr;
+            const int nnear = wall->getNeighbors(near);
+            for (int c = 0; c < nnear; ++c) {
+                const int i = near[c];
+                if (i >= nlocal) continue;
                 const size_t kk = k + i;
-                const double gap = x[i][a] - position[w];
-                if (r[i] - std::fabs(gap) <= 0) { off(kk, step, rebuilt); return; }
-                if (touch[kk] && !rebuilt) return;
-                double n[3] = {0, 0, 0};
-                n[a] = gap >= 0 ? 1.0 : -1.0;                                  // from the wall to the particle
-                on(kk, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(code[w]), tag[i], code[w], i, -1,
-                   -v[i][a] * n[a], n, new_planes);
-            };
-            if (close_only) for (int i : close_to[w]) test(i);
-            else for (int i = 0; i < nlocal; ++i) test(i);
-        }
-        // cylinders (particles inside or outside): overlap = radius - distance to the surface,
-        // the normal from the wall to the particle, as pyhost.engines.dem._primitive_contacts
-        for (size_t w = 0; w < cyl_axis.size(); ++w, k += nlocal) {
-            const int a = cyl_axis[w], b = (a + 1) % 3, c = (a + 2) % 3;
-            const int lo = std::min(b, c), hi = std::max(b, c);          // the other axes in order (c1, c2)
-            const double R = cyl_radius[w];
-            auto test = [&](int i) {
-                const size_t kk = k + i;
-                const double d1 = x[i][lo] - cyl_c1[w], d2 = x[i][hi] - cyl_c2[w];
-                const double dist = std::sqrt(d1 * d1 + d2 * d2);
-                const bool inside = dist < R;
-                if (r[i] - (inside ? R - dist : dist - R) <= 0) { off(kk, step, rebuilt); return; }
-                if (touch[kk] && !rebuilt) return;
-                const double s = (inside ? -1.0 : 1.0) / (dist > 0 ? dist : 1.0);
-                double n[3] = {0, 0, 0};
-                n[lo] = d1 * s; n[hi] = d2 * s;
-                on(kk, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(cyl_code[w]), tag[i], cyl_code[w],
+                double delta[3] = {0, 0, 0};
+                if (!(mask[i] & groupbit) || wall->resolveContact(x[i], r[i], delta) > 0) { off(kk, step, rebuilt); continue; }
+                if (touch[kk] && !rebuilt) continue;
+                const double len = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
+                const double d = len > 0 ? -len : 1.0;          // (a division: a plane's normal is +-1 exactly)
+                const double n[3] = {delta[0] / d, delta[1] / d, delta[2] / d};
+                on(kk, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(prim_code[w]), tag[i], prim_code[w],
                    i, -1, -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]), n, new_planes);
-            };
-            if (close_only) for (int i : close_to[axis.size() + w]) test(i);
-            else for (int i = 0; i < nlocal; ++i) test(i);
+            }
         }
         // mesh walls. Where LIGGGHTS keeps a contact history of the mesh (fix wall/gran with
         // tangential history) and its wall/gran fixes come before this fix (their post_force
@@ -621,35 +595,26 @@ void *collheat_events_attach(void *ptr, const char *fix_id)
     return rec;
 }
 
-// The host's primitive planes: n of them, each an axis (0, 1, 2), a position [m] and the
-// partner code of its contacts (WALL_BASE + the host's wall index). Particles touching a
-// plane when it is given are in contact, not colliding (as those touching anything at the start).
-void collheat_events_planes(void *handle, int n, const int *axis, const double *position, const double *code)
+// The primitive walls: n `fix wall/gran ... primitive` ids and the partner code of their contacts
+// (WALL_BASE + the host's wall index). Returns n, or -1 if one is not such a fix (nothing
+// changed then). Particles touching a wall when it is given are in contact, not colliding (as
+// those touching anything at the start).
+int collheat_events_primitives(void *handle, int n, const char **ids, const double *code)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
-    if (std::vector<int>(axis, axis + n) == rec->axis && std::vector<double>(position, position + n) == rec->position &&
-        std::vector<double>(code, code + n) == rec->code)
-        return;                                // the same planes again (at each run of a script)
-    rec->axis.assign(axis, axis + n);
-    rec->position.assign(position, position + n);
-    rec->code.assign(code, code + n);
+    std::vector<FixWallGran *> found;
+    for (int k = 0; k < n; ++k) {
+        const int f = rec->lmp->modify->find_fix(ids[k]);
+        if (f < 0 || std::strcmp(rec->lmp->modify->fix[f]->style, "wall/gran") != 0) return -1;
+        FixWallGran *wall = static_cast<FixWallGran *>(rec->lmp->modify->fix[f]);
+        if (!wall->primitiveWall()) return -1;
+        found.push_back(wall);
+    }
+    if (found == rec->prims && std::vector<double>(code, code + n) == rec->prim_code) return n;
+    rec->prims = found;                        // (the same walls again at each run of a script: kept)
+    rec->prim_code.assign(code, code + n);
     rec->new_planes = true;
-    rec->close_valid = false;
-}
-
-// The host's primitive cylinders: n of them, each an axis (0, 1, 2), a radius [m], the centre in
-// the two other coordinates (in axis order) [m] and the partner code of its contacts.
-void collheat_events_cylinders(void *handle, int n, const int *axis, const double *radius, const double *c1,
-                               const double *c2, const double *code)
-{
-    Recorder *rec = static_cast<Recorder *>(handle);
-    std::vector<int> a(axis, axis + n);
-    std::vector<double> R(radius, radius + n), x1(c1, c1 + n), x2(c2, c2 + n), k(code, code + n);
-    if (a == rec->cyl_axis && R == rec->cyl_radius && x1 == rec->cyl_c1 && x2 == rec->cyl_c2 && k == rec->cyl_code)
-        return;
-    rec->cyl_axis = a; rec->cyl_radius = R; rec->cyl_c1 = x1; rec->cyl_c2 = x2; rec->cyl_code = k;
-    rec->new_planes = true;
-    rec->close_valid = false;
+    return n;
 }
 
 // The host's mesh walls: n `fix mesh/surface` ids and the partner code of each. Returns the

@@ -24,10 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from pyhost.collisions import WALL_BASE
-from pyhost.walls import plane_of
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
-from pyhost.engines.events import RECORDED
 from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_values, put_by_id, set_random_states, write_local)
 from pyhost.script import Command, ScriptError, ScriptInfo
@@ -380,21 +378,11 @@ class Dem:
 
     # -- contacts ---------------------------------------------------------------------
     def event_planes(self, wall_index: dict) -> None:
-        """The primitive plane, cylinder and mesh walls, for the event recorder, with their
-        contact codes."""
-        unknown = [f"{fix} ({w.primitive[0]})" for fix, w in self.info.walls.items()
-                   if w.primitive is not None and w.primitive[0] not in RECORDED]
-        if unknown:
-            raise ScriptError(f"fix wall/gran {', '.join(unknown)}: a primitive wall kind the contact recorder "
-                              f"does not know (it records {', '.join(sorted(RECORDED))}): its collisions "
-                              "cannot be seen")
-        primitive = [(w.primitive, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items()
-                     if w.primitive is not None]
-        planes = [(*plane_of(p), code) for p, code in primitive if plane_of(p)]
-        self.events.planes(*(zip(*planes) if planes else ([], [], [])))
-        cylinders = [("xyz".index(kind[0]), *num[:3], code) for (kind, num), code in primitive
-                     if kind.endswith("cylinder")]
-        self.events.cylinders(*(zip(*cylinders) if cylinders else ([], [], [], [], [])))
+        """The primitive and mesh walls, for the event recorder, with their contact codes."""
+        primitive = [(fix, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items() if w.primitive is not None]
+        if not self.events.primitives(*(zip(*primitive) if primitive else ([], []))):
+            raise ScriptError(f"the primitive walls {', '.join(f for f, _ in primitive)}: one is not a fix wall/gran "
+                              "with a primitive wall the contact recorder can read: their collisions cannot be seen")
         meshes = [(mesh, WALL_BASE + wall_index[fix, k]) for fix, w in self.info.walls.items()
                   for k, mesh in enumerate(w.meshes or ())]
         if not self.events.meshes(*(zip(*meshes) if meshes else ([], []))):

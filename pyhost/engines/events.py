@@ -2,8 +2,8 @@
 
 ``ContactEvents(lmp)`` adds ``fix collheat_events all external pf/callback 1 APPLY`` and attaches
 the helper's recorder to it: from the next run on, every step (in compiled code, no Python)
-notes each particle-particle contact and each contact with the host's primitive planes that
-begins or ends. ``take()`` hands the events over in a batch, as a numpy structured array of
+notes each particle-particle contact and each contact with a wall (primitive walls by LIGGGHTS'
+own geometry, mesh walls) that begins or ends. ``take()`` hands the events over in a batch, as a numpy structured array of
 ``EVENT``: kind (``BEGIN`` or ``END``), step, i and j (atom ids, the smaller first; j is
 WALL_BASE + wall index for a wall), vn, the approach speed at the first step in contact [m/s]
 (the relative normal velocity before any contact force acted: the impact speed), the unit
@@ -40,10 +40,6 @@ def fix_command(fix: str = FIX) -> str:
     return f"fix {fix} all external pf/callback 1 {APPLY}"
 
 
-RECORDED = frozenset({"xplane", "yplane", "zplane", "xcylinder", "ycylinder", "zcylinder"})
-"""The primitive wall kinds (``pyhost.walls.PRIMITIVES``) whose contacts the recorder notes
-(``planes``, ``cylinders``; plugins/liggghts/contact_events.cpp): all six of LIGGGHTS 3.8. A
-wall of a kind not here is refused (``Dem.event_planes``): its collisions would go unseen."""
 ROW = 12
 BEGIN, END = 0, 1
 EVENT = np.dtype([("kind", np.int8), ("wall", np.bool_), ("step", np.int64), ("i", np.int64), ("j", np.int64),
@@ -54,7 +50,7 @@ _c = ctypes
 _vp, _int, _dp = _c.c_void_p, _c.c_int, _c.POINTER(_c.c_double)
 _DECLARATIONS = {
     "collheat_events_attach": (_vp, [_vp, _c.c_char_p]),
-    "collheat_events_planes": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp]),
+    "collheat_events_primitives": (_int, [_vp, _int, _c.POINTER(_c.c_char_p), _dp]),
     "collheat_events_meshes": (_int, [_vp, _int, _c.POINTER(_c.c_char_p), _dp]),
     "collheat_events_prime": (None, [_vp]),
     "collheat_events_sync": (None, [_vp]),
@@ -67,7 +63,6 @@ _DECLARATIONS = {
     "collheat_events_histories": (_int, [_vp, _int]),
     "collheat_events_take_histories": (_int, [_vp, _dp, _int]),
     "collheat_events_appeared": (_int, [_vp, _dp, _int]),
-    "collheat_events_cylinders": (None, [_vp, _int, _c.POINTER(_int), _dp, _dp, _dp, _dp]),
     "collheat_events_restitution": (None, [_vp, _int, _c.POINTER(_c.c_int64), _dp, _dp]),
     "collheat_events_forget": (None, [_vp, _int, _c.POINTER(_c.c_int64)]),
     "collheat_events_meshes_by_history": (_int, [_vp]),
@@ -139,22 +134,14 @@ class ContactEvents:
         ids = raw[:, :3].astype(np.int64)
         return ids[:, 0], ids[:, 1], ids[:, 2], raw[:, 3].astype(np.int64), raw[:, HEAD:]
 
-    def planes(self, axes, positions, codes) -> None:
-        """Primitive plane walls: axis (0, 1, 2 for x, y, z), position [m], and the partner
-        code (WALL_BASE + wall index) of each."""
-        axes = np.ascontiguousarray(axes, dtype=np.intc)
-        positions = np.ascontiguousarray(positions, dtype=float)
+    def primitives(self, ids, codes) -> bool:
+        """Primitive walls (planes, cylinders: any kind LIGGGHTS has): the ``fix wall/gran ...
+        primitive`` id and the partner code (WALL_BASE + wall index) of each. The recorder takes
+        their geometry, their list of nearby particles and their group from LIGGGHTS' own fix.
+        False (nothing changed) if one is not such a fix."""
+        arr = (_c.c_char_p * len(ids))(*[i.encode() for i in ids])
         codes = np.ascontiguousarray(codes, dtype=float)
-        self.lmp.helper.collheat_events_planes(self.handle, len(axes), axes.ctypes.data_as(_c.POINTER(_int)),
-                                               positions.ctypes.data_as(_dp), codes.ctypes.data_as(_dp))
-
-    def cylinders(self, axes, radii, c1, c2, codes) -> None:
-        """Primitive cylinder walls: axis (0, 1, 2), radius [m], the centre in the two other
-        coordinates (in axis order) [m], and the partner code of each."""
-        axes = np.ascontiguousarray(axes, dtype=np.intc)
-        arrays = [np.ascontiguousarray(a, dtype=float) for a in (radii, c1, c2, codes)]
-        self.lmp.helper.collheat_events_cylinders(self.handle, len(axes), axes.ctypes.data_as(_c.POINTER(_int)),
-                                                  *(a.ctypes.data_as(_dp) for a in arrays))
+        return self.lmp.helper.collheat_events_primitives(self.handle, len(ids), arr, codes.ctypes.data_as(_dp)) >= 0
 
     def meshes(self, ids, codes) -> bool:
         """Mesh walls: the ``fix mesh/surface`` id and the partner code of each. False (and
@@ -221,7 +208,7 @@ class ContactEvents:
             self.handle = None
 
 
-GATHERED = {"take", "histories", "appeared", "meshes", "waiting", "open_count", "totals"}
+GATHERED = {"take", "histories", "appeared", "primitives", "meshes", "waiting", "open_count", "totals"}
 """What each rank answers to rank 0 (the others' recorders change only their own state)."""
 
 
@@ -285,11 +272,8 @@ class RankEvents:
     def conduction(self, fix: str, window: int) -> None:
         self._all("conduction", fix, window)
 
-    def planes(self, *args) -> None:
-        self._all("planes", *[list(a) for a in args])
-
-    def cylinders(self, *args) -> None:
-        self._all("cylinders", *[list(a) for a in args])
+    def primitives(self, ids, codes) -> bool:
+        return all(self._all("primitives", list(ids), list(codes)))
 
     def meshes(self, ids, codes) -> bool:
         return all(self._all("meshes", list(ids), list(codes)))

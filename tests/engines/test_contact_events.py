@@ -73,7 +73,8 @@ def test_a_sphere_dropped_on_a_plane_begins_at_the_free_fall_speed(tmp_path):
             fix integrate all nve/sphere
         """)
         ev = ContactEvents(lg)
-        ev.planes([2], [-0.01], [WALL_BASE + 0])
+        assert not ev.primitives(["gravi"], [WALL_BASE + 0])      # not a primitive wall: refused
+        assert ev.primitives(["floor"], [WALL_BASE + 0])
         lg.run(40000)
         got = ev.take()
     begin = got[got["kind"] == BEGIN]
@@ -99,7 +100,7 @@ def test_a_sphere_thrown_at_a_cylinder_wall_begins_at_its_radial_speed(tmp_path)
             fix integrate all nve/sphere
         """)
         ev = ContactEvents(lg)
-        ev.cylinders([2], [Rc], [cx], [cy], [WALL_BASE + 0])
+        assert ev.primitives(["tube"], [WALL_BASE + 0])
         lg.run(30000)
         got = ev.take()
     begin = got[got["kind"] == BEGIN]
@@ -111,11 +112,43 @@ def test_a_sphere_thrown_at_a_cylinder_wall_begins_at_its_radial_speed(tmp_path)
     assert np.allclose(begin[0]["n"], [-v[0] / speed, -v[1] / speed, 0.0], atol=1e-9)
 
 
+def test_a_ycylinder_reads_its_axis_as_liggghts_does(tmp_path):
+    """LIGGGHTS reads ``ycylinder R c1 c2`` with c1 the axis' z and c2 its x (the axes after y,
+    cyclically; primitive_wall_definitions.h), not x then z. A sphere on that axis, thrown
+    outward in x and z, begins touching the wall at the step free flight gives, at its whole
+    speed, the normal pointing back to the axis; pyhost.walls (post, the scene checks) sees
+    the same contact there."""
+    from pyhost.walls import primitive_overlap
+
+    Rc, c1, c2, v = 0.008, 0.002, -0.001, (0.3, 0.41)         # axis at z = c1, x = c2
+    with box(tmp_path) as lg:
+        lg.commands(f"""
+            fix tube all wall/gran model hertz tangential history primitive type 1 ycylinder {Rc} {c1} {c2}
+            create_atoms 1 single {c2} 0 {c1} units box
+            set atom 1 diameter {2 * R} density {RHO} vx {v[0]} vz {v[1]}
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        assert ev.primitives(["tube"], [WALL_BASE + 0])
+        speed = math.hypot(*v)
+        first = math.floor((Rc - R) / speed / DT) + 1
+        lg.run(first)
+        got = ev.take()
+        x = lg.atom("x").copy()
+    begin = got[got["kind"] == BEGIN]
+    assert len(begin) == 1 and begin[0]["step"] == first
+    assert begin[0]["vn"] == pytest.approx(speed, rel=1e-12)
+    assert np.allclose(begin[0]["n"], [-v[0] / speed, 0.0, -v[1] / speed], atol=1e-9)
+    delta, normal = primitive_overlap(x, np.array([R]), ("ycylinder", (Rc, c1, c2)))
+    assert delta[0] > 0 and np.allclose(normal[0], begin[0]["n"], atol=1e-9)
+
+
 def test_wall_events_follow_the_geometry_step_by_step(tmp_path):
     """200 spheres poured into a zcylinder (radius 8 mm) on a floor plane, beside an xplane: at
     every step the particles that begin and end touching each primitive wall are exactly those
-    whose distance to it crosses their radius (LIGGGHTS' own test). Between neighbour builds
-    the recorder tests only the particles near each wall, listed at the build."""
+    whose distance to it crosses their radius (LIGGGHTS' own test). The recorder takes each
+    wall's geometry and its list of nearby particles (made at each neighbour build) from
+    LIGGGHTS' fix wall/gran."""
     Rc, floor, side = 0.008, -0.01, 0.0075
     with box(tmp_path, dt=1e-5) as lg:
         lg.commands(f"""
@@ -130,8 +163,7 @@ def test_wall_events_follow_the_geometry_step_by_step(tmp_path):
             fix integrate all nve/sphere
         """)
         ev = ContactEvents(lg)
-        ev.planes([2, 0], [floor, side], [WALL_BASE + 0, WALL_BASE + 1])
-        ev.cylinders([2], [Rc], [0.0], [0.0], [WALL_BASE + 2])
+        assert ev.primitives(["floor", "side", "tube"], [WALL_BASE + 0, WALL_BASE + 1, WALL_BASE + 2])
         lg.run(1)
         ev.take()
 
@@ -163,8 +195,8 @@ def test_a_sphere_grown_into_a_plane_begins_touching_it(tmp_path):
     """A sphere at rest 1.7 R above a plane (farther than its radius and the skin, R/2, when the
     recorder first lists the particles near each wall), grown by fix adapt at every step until
     it reaches the plane: the contact begins at the step the radius passes the gap. (LIGGGHTS
-    builds its lists again as the growth uses up the skin; the recorder lists the particles near
-    a wall again at every change of radius.)"""
+    builds its lists again, the wall's list of nearby particles among them, as the growth uses
+    up the skin.)"""
     gap = 1.7 * R
     with box(tmp_path) as lg:
         lg.commands(f"""
@@ -174,7 +206,7 @@ def test_a_sphere_grown_into_a_plane_begins_touching_it(tmp_path):
             fix integrate all nve/sphere
         """)
         ev = ContactEvents(lg)
-        ev.planes([2], [0.0], [WALL_BASE])
+        assert ev.primitives(["floor"], [WALL_BASE])
         lg.run(1)
         ev.take()
         lg.commands(f"""

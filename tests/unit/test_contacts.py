@@ -90,22 +90,3 @@ def test_cylinder_wall_inside_and_outside():
     assert c.delta[k] == pytest.approx(0.03) and np.allclose(c.normal[k], [-1, 0, 0]) and c.approach[k] == pytest.approx(2.0)
     k = list(c.i).index(1)
     assert c.delta[k] == pytest.approx(0.02) and np.allclose(c.normal[k], [0, -1, 0]) and c.approach[k] == pytest.approx(1.0)
-
-
-def test_every_primitive_wall_kind_is_recorded_and_an_unrecorded_one_is_refused(monkeypatch):
-    """Runs see walls only through the contact recorder: every kind pyhost.walls reads
-    (LIGGGHTS 3.8's six primitives) is one it records, and a kind it does not record is a
-    ScriptError naming the wall, not a wall whose collisions go unseen."""
-    from pyhost.engines import dem as dem_module
-    from pyhost.engines.dem import Dem
-    from pyhost.engines.events import RECORDED
-    from pyhost.script import GranWall, ScriptError, ScriptInfo
-    from pyhost.walls import PRIMITIVES
-
-    assert RECORDED == set(PRIMITIVES)
-    d = Dem.__new__(Dem)
-    d.info = ScriptInfo()
-    d.info.walls["floor"] = GranWall("floor", primitive=("zplane", (0.0,)), type=1)
-    monkeypatch.setattr(dem_module, "RECORDED", frozenset({"zcylinder"}))
-    with pytest.raises(ScriptError, match="floor.*zplane"):
-        d.event_planes({("floor", 0): 0})
