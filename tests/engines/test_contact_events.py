@@ -112,6 +112,29 @@ def test_a_sphere_thrown_at_a_cylinder_wall_begins_at_its_radial_speed(tmp_path)
     assert np.allclose(begin[0]["n"], [-v[0] / speed, -v[1] / speed, 0.0], atol=1e-9)
 
 
+def test_a_wall_of_a_group_meets_only_that_group(tmp_path):
+    """A plane whose fix wall/gran acts on group 'held' only: of two spheres moving down onto it
+    at 0.5 m/s, the one of that group bounces (one wall contact begins, at its speed), the other
+    passes through it as LIGGGHTS lets it (no contact recorded for it)."""
+    with box(tmp_path) as lg:
+        lg.commands(f"""
+            create_atoms 1 single -0.004 0 {2 * R} units box
+            create_atoms 1 single 0.004 0 {2 * R} units box
+            set atom * diameter {2 * R} density {RHO} vz -0.5
+            group held id 1
+            fix floor held wall/gran model hertz tangential history primitive type 1 zplane 0.0
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        assert ev.primitives(["floor"], [WALL_BASE + 0])
+        lg.run(round(4 * R / 0.5 / DT))
+        got = ev.take()
+        z = dict(zip(lg.atom("id").astype(int).tolist(), lg.atom("x")[:, 2].tolist()))
+    begin = got[got["kind"] == BEGIN]
+    assert begin["i"].tolist() == [1] and begin[0]["vn"] == pytest.approx(0.5, rel=1e-12)
+    assert z[1] > 0 > z[2]                     # the held one bounced, the other went through
+
+
 def test_a_ycylinder_reads_its_axis_as_liggghts_does(tmp_path):
     """LIGGGHTS reads ``ycylinder R c1 c2`` with c1 the axis' z and c2 its x (the axes after y,
     cyclically; primitive_wall_definitions.h), not x then z. A sphere on that axis, thrown
