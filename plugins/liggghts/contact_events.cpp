@@ -102,7 +102,7 @@ struct Recorder {
     std::vector<double> mesh_code;             // of its contacts (one per particle and mesh: the deepest)
     std::vector<double> depth, normal;         // per local atom, this call and mesh: overlap [m] and normal,
     std::vector<int> deepest;                  // and the deepest triangle (meshes without a contact history)
-    bool new_planes = false;                   // walls given since the last call: what touches them is open
+    bool new_walls = false;                   // walls given since the last call: what touches them is open
     long long begun = 0, ended = 0;
     int meshes_by_history = 0;                 // meshes read from LIGGGHTS' contact history at the last call
     struct Target { double speed, n[3]; };     // separation speed [m/s] to impose at the end; a wall's normal
@@ -127,7 +127,7 @@ struct Recorder {
     bigint layout_last = -1;                   // neighbor->lastcall (init() starts ncalls again),
     const NeighList *layout_list = nullptr;    // the list and its atoms
     int layout_inum = -1;
-    size_t planes_laid = 0;                    // walls and local atoms in the layout
+    size_t walls_laid = 0;                    // walls and local atoms in the layout
     int nlocal_laid = -1;
     std::vector<uint8_t> touch;                // in contact at the last call
     std::vector<bigint> since;                 // step of the first call in contact
@@ -338,7 +338,7 @@ struct Recorder {
         const double vn = -((v[i][0] - vw[0]) * n[0] + (v[i][1] - vw[1]) * n[1] + (v[i][2] - vw[2]) * n[2]);
         const int *tag = lmp->atom->tag;
         on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]), tag[i], mesh_code[m],
-           i, -1, vn, n, new_planes);
+           i, -1, vn, n, new_walls);
     }
 
     // Whether every fix wall/gran comes before this fix: their post_force (and the mesh
@@ -376,19 +376,19 @@ struct Recorder {
         Pair *pair = lmp->force->pair;
         NeighList *list = pair ? pair->list : nullptr;
         const bool have_list = list && list->ilist;
-        // a new layout at each neighbour build (or new planes): the slots counted then only
+        // a new layout at each neighbour build (or new walls): the slots counted then only
         const size_t walls = prims.size() + meshes.size();
         // (a run's set-up calls Neighbor::init, which counts builds from 0 again: the step of
         // the last build and the list itself tell a build that ncalls alone misses)
         const Neighbor *nb = lmp->neighbor;
-        const bool rebuilt = nb->ncalls != layout || nb->lastcall != layout_last || walls != planes_laid ||
+        const bool rebuilt = nb->ncalls != layout || nb->lastcall != layout_last || walls != walls_laid ||
                              nlocal != nlocal_laid || (have_list && (list != layout_list || list->inum != layout_inum));
         if (rebuilt) {                         // the open contacts, by key, into the new layout
             size_t slots = 0;
             if (have_list)
                 for (int ii = 0; ii < list->inum; ++ii) slots += list->numneigh[list->ilist[ii]];
             slots += walls * size_t(nlocal);
-            planes_laid = walls;
+            walls_laid = walls;
             nlocal_laid = nlocal;
             carry.clear();
             for (size_t k = 0; k < touch.size(); ++k)
@@ -474,7 +474,7 @@ struct Recorder {
                 const double d = len > 0 ? -len : 1.0;          // (a division: a plane's normal is +-1 exactly)
                 const double n[3] = {delta[0] / d, delta[1] / d, delta[2] / d};
                 on(kk, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(prim_code[w]), tag[i], prim_code[w],
-                   i, -1, -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]), n, new_planes);
+                   i, -1, -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]), n, new_walls);
             }
         }
         // mesh walls. Where LIGGGHTS keeps a contact history of the mesh (fix wall/gran with
@@ -553,7 +553,7 @@ struct Recorder {
             carry.clear();
         }
         primed = true;
-        new_planes = false;
+        new_walls = false;
     }
 
     long long open_count() const
@@ -613,7 +613,7 @@ int collheat_events_primitives(void *handle, int n, const char **ids, const doub
     if (found == rec->prims && std::vector<double>(code, code + n) == rec->prim_code) return n;
     rec->prims = found;                        // (the same walls again at each run of a script: kept)
     rec->prim_code.assign(code, code + n);
-    rec->new_planes = true;
+    rec->new_walls = true;
     return n;
 }
 
@@ -633,7 +633,7 @@ int collheat_events_meshes(void *handle, int n, const char **ids, const double *
     if (found == rec->meshes && std::vector<double>(code, code + n) == rec->mesh_code) return n;
     rec->meshes = found;
     rec->mesh_code.assign(code, code + n);
-    rec->new_planes = true;
+    rec->new_walls = true;
     return n;
 }
 

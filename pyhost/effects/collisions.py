@@ -67,7 +67,7 @@ class CollisionHeat(Effect):
         self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
         self.T_wall = np.array([w.temperature if self.loop.effects["wall_heat"] else np.nan for w in walls])
         self.wall_material = np.array([w.material for w in walls], int)
-        self.dem.event_planes(self.wall_index)
+        self.dem.event_walls(self.wall_index)
 
     def after_chunk(self, due: dict):
         """The contacts' work at the end of a DEM chunk: the events harvested, if due. Returns

@@ -377,7 +377,7 @@ class Dem:
         return self.events is not None and self.events.window > 0
 
     # -- contacts ---------------------------------------------------------------------
-    def event_planes(self, wall_index: dict) -> None:
+    def event_walls(self, wall_index: dict) -> None:
         """The primitive and mesh walls, for the event recorder, with their contact codes."""
         primitive = [(fix, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items() if w.primitive is not None]
         if not self.events.primitives(*(zip(*primitive) if primitive else ([], []))):

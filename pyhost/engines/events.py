@@ -2,12 +2,13 @@
 
 ``ContactEvents(lmp)`` adds ``fix collheat_events all external pf/callback 1 APPLY`` and attaches
 the helper's recorder to it: from the next run on, every step (in compiled code, no Python)
-notes each particle-particle contact and each contact with a wall (primitive walls by LIGGGHTS'
-own geometry, mesh walls) that begins or ends. ``take()`` hands the events over in a batch, as a numpy structured array of
-``EVENT``: kind (``BEGIN`` or ``END``), step, i and j (atom ids, the smaller first; j is
-WALL_BASE + wall index for a wall), vn, the approach speed at the first step in contact [m/s]
-(the relative normal velocity before any contact force acted: the impact speed), the unit
-normal n from j to i, and for an END the contact's duration in steps. Units SI.
+notes each particle-particle contact and each contact with a wall (primitive walls by
+LIGGGHTS' own geometry, mesh walls) that begins or ends. ``take()`` hands the events over in
+a batch, as a numpy structured array of ``EVENT``: kind (``BEGIN`` or ``END``), step, i and
+j (atom ids, the smaller first; j is WALL_BASE + wall index for a wall), vn, the approach
+speed at the first step in contact [m/s] (the relative normal velocity before any contact
+force acted: the impact speed), the unit normal n from j to i, and for an END the contact's
+duration in steps. Units SI.
 
 With a script's fix heat/gran, ``conduction(fix, window)`` has the recorder also keep the flux
 heat/gran conducts through each new pair contact at each of its first ``window`` steps (its

@@ -102,7 +102,7 @@ class DemEngine(Protocol):
         """Whether the script's fix heat/gran's conduction per contact can be read."""
 
     # -- contacts ----------------------------------------------------------------------
-    def event_planes(self, wall_index: dict) -> None:
+    def event_walls(self, wall_index: dict) -> None:
         """Hand the recorder the walls it records contacts with, by their host codes."""
 
     # -- what a checkpoint keeps that the engine's restart does not ------------------------
