@@ -70,7 +70,7 @@ class ContactFinder:
         return d - np.where(self.per, self.size * np.round(d / self.size), 0.0)
 
     def _rebuild(self, x) -> None:
-        from scipy.spatial import cKDTree   # here: only sampled contacts need it (0.1-0.3 s to import)
+        from scipy.spatial import cKDTree   # here: only post's contacts need it (0.1-0.3 s to import)
 
         cutoff = 2.0 * self.r.max() + self.skin
         if self.per.any():

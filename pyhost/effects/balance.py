@@ -23,12 +23,12 @@ below 1e-12 on every case the tests run."""
 
 class EnergyBalance(Effect):
     """Each particle's heat content m c T [J], mass [kg] and entry temperature [K] by id, as
-    of its last sample; ``C``: m c [J/K] of the atoms last seen, in their order."""
+    when last seen; ``C``: m c [J/K] of the atoms last seen, in their order."""
 
     def __init__(self, loop):
         super().__init__(loop)
-        self.CT_by_id = np.zeros(0)       # m c T of each id at its last sample [J] (energy balance)
-        self.M_by_id = np.zeros(0)        # mass of each id at its last sample [kg] (0: not known)
+        self.CT_by_id = np.zeros(0)       # m c T of each id when last seen [J] (energy balance)
+        self.M_by_id = np.zeros(0)        # mass of each id when last seen [kg] (0: not known)
         self.T_first_by_id = np.zeros(0)  # temperature each id came in with [K] (the frames' change)
         self.seen = np.zeros(0, bool)
         self.C = np.zeros(0)
@@ -45,7 +45,7 @@ class EnergyBalance(Effect):
     def track(self, atoms, departures: bool = True) -> None:
         """Inserted particles: their material's temperature (if the scene gives one) and their
         heat content enters the balance; departed ones (deleted, lost) leave it with the heat
-        content of their last sample; particles whose mass changed since their last sample
+        content they had when last seen; particles whose mass changed since they were last seen
         (a script's fix adapt, set ... density) change their heat content by c dm T, the
         balance's ``energy_mass_change`` (at the current T: the heat the host moved in between
         went in at the old mass's capacity, so the two add up to the change of m c T exactly).
@@ -107,7 +107,7 @@ class EnergyBalance(Effect):
     def resync(self) -> None:
         """Before each run: heat content that the script's own commands changed since the last
         run (e.g. ``set ... property/atom Temp``) enters the balance as set by the script (at
-        the masses of the last sample: a mass change is ``track``'s term)."""
+        the masses last seen: a mass change is ``track``'s term)."""
         loop = self.loop
         atoms = loop.dem.atoms(True)
         known = np.zeros(len(atoms.id), bool)
