@@ -86,6 +86,32 @@ def test_a_sphere_dropped_on_a_plane_begins_at_the_free_fall_speed(tmp_path):
     assert np.allclose(begin[0]["n"], [0, 0, 1])
 
 
+def test_a_plane_given_after_the_recorder_sees_a_falling_sphere_and_not_a_resting_one(tmp_path):
+    """A plane whose fix wall/gran comes after the recorder's fix (a script adding a wall
+    between runs): at the run's set-up the recorder runs before the wall has listed its nearby
+    particles, so it lists them itself. A sphere already touching the plane when it is given
+    is in contact, not colliding; one falling onto it begins at the free-fall speed."""
+    h = 0.002
+    with box(tmp_path, dt=1e-6) as lg:
+        lg.commands(f"""
+            fix gravi all gravity 9.81 vector 0 0 -1
+            create_atoms 1 single -0.004 0 {R * 0.999} units box
+            create_atoms 1 single 0.004 0 {R + h} units box
+            set atom * diameter {2 * R} density {RHO}
+            fix integrate all nve/sphere
+        """)
+        ev = ContactEvents(lg)
+        lg.run(1)
+        lg.commands("fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0")
+        assert ev.primitives(["floor"], [WALL_BASE + 0])
+        lg.run(25000)
+        got = ev.take()
+    begin = got[got["kind"] == BEGIN]
+    v = math.sqrt(2 * 9.81 * h)
+    assert begin["i"].tolist() == [2], "the resting sphere counted as a collision, or the falling one missed"
+    assert begin[0]["vn"] == pytest.approx(v, rel=1e-3)
+
+
 def test_a_sphere_thrown_at_a_cylinder_wall_begins_at_its_radial_speed(tmp_path):
     """A sphere inside a zcylinder wall (radius 8 mm, axis off the origin), thrown outward along
     x and y at once: it begins touching the cylinder at the step its surface reaches it, with
