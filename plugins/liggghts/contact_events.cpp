@@ -578,6 +578,30 @@ void callback(void *ptr, bigint step, int nlocal, int *, double **, double **f)
     rec->record(step);
 }
 
+// The walls of one kind: the fixes of these n ids, each of a style beginning with `style` and
+// usable (`usable`), with their partner codes, become the recorder's `fixes` and `codes`.
+// Returns n, or -1 if one is not such a fix (nothing changed then). Walls given anew: the
+// particles touching them then are in contact, not colliding (as those touching anything at
+// the start); the same walls again (at each run of a script) change nothing.
+template <class F, class Usable>
+int set_walls(Recorder *rec, int n, const char **ids, const double *code, const char *style, Usable usable,
+              std::vector<F *> &fixes, std::vector<double> &codes)
+{
+    std::vector<F *> found;
+    for (int k = 0; k < n; ++k) {
+        const int f = rec->lmp->modify->find_fix(ids[k]);
+        if (f < 0 || std::strncmp(rec->lmp->modify->fix[f]->style, style, std::strlen(style)) != 0) return -1;
+        F *wall = static_cast<F *>(rec->lmp->modify->fix[f]);
+        if (!usable(wall)) return -1;
+        found.push_back(wall);
+    }
+    if (found == fixes && std::vector<double>(code, code + n) == codes) return n;
+    fixes = found;
+    codes.assign(code, code + n);
+    rec->new_walls = true;
+    return n;
+}
+
 }  // namespace
 
 extern "C" {
@@ -595,46 +619,22 @@ void *collheat_events_attach(void *ptr, const char *fix_id)
     return rec;
 }
 
-// The primitive walls: n `fix wall/gran ... primitive` ids and the partner code of their contacts
-// (WALL_BASE + the host's wall index). Returns n, or -1 if one is not such a fix (nothing
-// changed then). Particles touching a wall when it is given are in contact, not colliding (as
-// those touching anything at the start).
+// The primitive walls: n `fix wall/gran ... primitive` ids and the partner code of their
+// contacts (WALL_BASE + the host's wall index); -1 if one is not such a fix.
 int collheat_events_primitives(void *handle, int n, const char **ids, const double *code)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
-    std::vector<FixWallGran *> found;
-    for (int k = 0; k < n; ++k) {
-        const int f = rec->lmp->modify->find_fix(ids[k]);
-        if (f < 0 || std::strcmp(rec->lmp->modify->fix[f]->style, "wall/gran") != 0) return -1;
-        FixWallGran *wall = static_cast<FixWallGran *>(rec->lmp->modify->fix[f]);
-        if (!wall->primitiveWall()) return -1;
-        found.push_back(wall);
-    }
-    if (found == rec->prims && std::vector<double>(code, code + n) == rec->prim_code) return n;
-    rec->prims = found;                        // (the same walls again at each run of a script: kept)
-    rec->prim_code.assign(code, code + n);
-    rec->new_walls = true;
-    return n;
+    return set_walls(rec, n, ids, code, "wall/gran", [](FixWallGran *w) { return w->primitiveWall() != nullptr; },
+                     rec->prims, rec->prim_code);
 }
 
-// The host's mesh walls: n `fix mesh/surface` ids and the partner code of each. Returns the
-// number found with a neighbour list (a mesh used by a fix wall/gran), or -1 if one is not.
+// The host's mesh walls: n `fix mesh/surface` ids and the partner code of each; -1 if one has
+// no neighbour list (a mesh used by no fix wall/gran).
 int collheat_events_meshes(void *handle, int n, const char **ids, const double *code)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
-    std::vector<FixMeshSurface *> found;
-    for (int k = 0; k < n; ++k) {
-        const int f = rec->lmp->modify->find_fix(ids[k]);
-        if (f < 0 || std::strncmp(rec->lmp->modify->fix[f]->style, "mesh/surface", 12) != 0) return -1;
-        FixMeshSurface *mesh = static_cast<FixMeshSurface *>(rec->lmp->modify->fix[f]);
-        if (!mesh->meshNeighlist()) return -1;
-        found.push_back(mesh);
-    }
-    if (found == rec->meshes && std::vector<double>(code, code + n) == rec->mesh_code) return n;
-    rec->meshes = found;
-    rec->mesh_code.assign(code, code + n);
-    rec->new_walls = true;
-    return n;
+    return set_walls(rec, n, ids, code, "mesh/surface", [](FixMeshSurface *m) { return m->meshNeighlist() != nullptr; },
+                     rec->meshes, rec->mesh_code);
 }
 
 // The next call records the contacts present as open, with no BEGIN events (a start or restart).
