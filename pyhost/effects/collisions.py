@@ -162,8 +162,9 @@ class CollisionHeat(Effect):
         contact is a collision, at its impact speed as recorded at first touch, its heat moved
         now in the order the collisions happened. Without a fix heat/gran nothing else changes
         a temperature between two harvests (they come at every frame and checkpoint, at a fluid
-        exchange that reads the temperatures, and at least every HARVEST_EVERY steps), so the heat is what it would be if moved at each collision's own step; with
-        one, each collision takes the temperature difference it began with (the recorder notes
+        exchange that reads the temperatures, and at least every HARVEST_EVERY steps), so the
+        heat is what it would be if moved at each collision's own step (tests/cases/
+        test_batch_delay.py); with one, each collision takes the temperature difference it began with (the recorder notes
         the two temperatures at its first step), and what heat/gran conducted through each new
         contact during the collision's model time is taken back (``take_back_heat_gran``;
         ``final``: also for contacts younger than its window, at a checkpoint or the end). A
