@@ -124,8 +124,8 @@ class CollisionHeat(Effect):
 
     def partners(self, atoms, i, j):
         """For contacts between local atoms i and partners j (atom ids, or WALL_BASE + wall):
-        whether j is a wall, j as a local index or wall code, its material, atom type (walls:
-        their LIGGGHTS type), radius [m] and mass [kg] (inf for walls)."""
+        whether j is a wall, j as a local index or wall code, its material, radius [m] and mass
+        [kg] (inf for walls)."""
         wall = j >= WALL_BASE
         jl = np.where(wall, j, atoms.index(np.where(wall, 0, j)))
         w = np.where(wall, j - WALL_BASE, 0)
@@ -133,10 +133,7 @@ class CollisionHeat(Effect):
         mat_i = self.loop.materials_of(atoms.type[i])
         wall_mat = np.where(self.wall_material[w] >= 0, self.wall_material[w], mat_i) if len(self.walls) else mat_i
         mat = np.where(wall, wall_mat, self.loop.materials_of(atoms.type[jj]))
-        wall_type = np.array([self.dem.info.wall_type(wl.fix, wl.mesh) or 1 for wl in self.walls] or [1])
-        typ = np.where(wall, wall_type[w], atoms.type[jj])
-        return (wall, jl, mat, typ, np.where(wall, np.inf, atoms.radius[jj]),
-                np.where(wall, np.inf, atoms.mass[jj]))
+        return wall, jl, mat, np.where(wall, np.inf, atoms.radius[jj]), np.where(wall, np.inf, atoms.mass[jj])
 
     def harvest_alone(self, due) -> bool:
         """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran:
@@ -164,10 +161,11 @@ class CollisionHeat(Effect):
         a temperature between two harvests (they come at every frame and checkpoint, at a fluid
         exchange that reads the temperatures, and at least every HARVEST_EVERY steps), so the
         heat is what it would be if moved at each collision's own step (tests/cases/
-        test_batch_delay.py); with one, each collision takes the temperature difference it began with (the recorder notes
-        the two temperatures at its first step), and what heat/gran conducted through each new
-        contact during the collision's model time is taken back (``take_back_heat_gran``;
-        ``final``: also for contacts younger than its window, at a checkpoint or the end). A
+        test_batch_delay.py); with one, each collision takes the temperature difference it
+        began with (the recorder notes the two temperatures at its first step), and what
+        heat/gran conducted through each new contact during the collision's model time is taken
+        back (``take_back_heat_gran``; ``final``: also for contacts younger than its window, at
+        a checkpoint or the end). A
         collision whose particle left the simulation before the harvest (deleted, out of the
         box) is counted apart (collisions_of_departed) and moves no heat: its heat content left
         when it was last seen; so is one that began with no approach speed
@@ -226,22 +224,22 @@ class CollisionHeat(Effect):
         # order in memory (a restart or another number of ranks changes it)
         begin = begin[np.lexsort((begin["j"], begin["i"], begin["wall"], begin["step"]))]
         if len(begin):
-            at = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["n"], begin["step"] * self.dem.dt,
-                              T_begin=begin["T"])
+            t_coll, e = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["step"] * self.dem.dt,
+                                     T_begin=begin["T"])
             if self.dem.events.window:          # each pair collision's model time, until its flux history comes
                 pair = ~begin["wall"]
                 keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
-                self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), at[pair, 1].tolist()))
+                self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), t_coll[pair].tolist()))
             if self.restitution:
-                self.ask_restitution(atoms, begin, at, ends)
+                self.ask_restitution(atoms, begin, e, ends)
 
-    def ask_restitution(self, atoms, begin, at, ends) -> None:
+    def ask_restitution(self, atoms, begin, e, ends) -> None:
         """Restitution feedback on contact events: each collision's separation speed e v0 (e
         above 1 clipped, counted) handed to the recorder, which imposes it at the step the
         contact ends. A contact that ended before this harvest (shorter than the harvest
         interval, time.sample_every steps) gets it now, from the velocities now (counted as
-        restitution_late)."""
-        e, v0 = at[:, 2], at[:, 3]
+        restitution_late). ``e``: each begun collision's restitution from its model."""
+        v0 = begin["vn"]
         self.totals["clipped"] += int(np.sum(e > 1.0))
         speed = np.minimum(e, 1.0) * v0
         keys = contact_keys(begin["i"], begin["j"])
@@ -287,16 +285,16 @@ class CollisionHeat(Effect):
         np.add.at(atoms.T, b, q / self.loop.C[b])
         self.totals["heat_gran_undone"] += float(np.abs(q).sum())
 
-    def collide(self, atoms, ids_i, j, v0, normal, time, T_begin=None) -> np.ndarray:
+    def collide(self, atoms, ids_i, j, v0, time, T_begin=None):
         """Collisions of particles ``ids_i`` with partners ``j`` (ids, or WALL_BASE + wall) at
-        impact speeds v0 [m/s] with unit normals (j to i), begun at ``time`` [s]: the plugin's
-        heat moved in this order, the totals and the collision log. Returns, per collision, its
-        time [s], model duration t_coll [s], the model's restitution e (NaN: none to impose),
-        impact speed [m/s] and unit normal. ``T_begin`` (n, 2) [K]: the two temperatures when each began (NaN: as now), where
-        something else (a fix heat/gran) changed them since: each collision's temperature
-        difference is the one it began with, plus what earlier collisions of this batch moved."""
+        impact speeds v0 [m/s], begun at ``time`` [s]: the plugin's heat moved in this order, the
+        totals and the collision log. Returns each collision's model duration t_coll [s] and
+        restitution e (zeros without particle temperatures). ``T_begin`` (n, 2) [K]: the two
+        temperatures when each began (NaN: as now), where something else (a fix heat/gran)
+        changed them since: each collision's temperature difference is the one it began with,
+        plus what earlier collisions of this batch moved."""
         i = atoms.index(ids_i)
-        wall, jl, mj, _, R_j, _ = self.partners(atoms, i, j)
+        wall, jl, mj, R_j, _ = self.partners(atoms, i, j)
         mi, R_i = self.loop.materials_of(atoms.type[i]), atoms.radius[i]
         rows = np.arange(len(i))
         models = self.scene.effects.heat_models
@@ -328,7 +326,7 @@ class CollisionHeat(Effect):
         self.log.write_columns(time=time, i=ids_i, j=np.where(wall, 0, j),
                                       wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
                                       t_coll=t_coll, model=np.full(len(rows), model), **side)
-        return np.column_stack([time, t_coll, e, v0, normal])
+        return t_coll, e
 
     def heat_by_model(self) -> dict:
         """Heat between particles [J], sum of |Q| over collisions, of each heat model: the one
@@ -343,7 +341,7 @@ class CollisionHeat(Effect):
         1 were clipped."""
         i = atoms.index(ids_i)
         here = (i >= 0) & ~np.isnan(e)
-        wall, jl, _, _, _, m_j = self.partners(atoms, np.maximum(i, 0), ids_j)
+        wall, jl, _, _, m_j = self.partners(atoms, np.maximum(i, 0), ids_j)
         here &= wall | (jl >= 0)
         normal = np.array(normal, float)
         jj = np.where(wall, 0, np.maximum(jl, 0))
