@@ -70,21 +70,23 @@ class Coupling:
     ``groups``: (names, function atoms -> group index per atom) for the history columns;
     ``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
     ``initial_T``: function (atoms, mask of new atoms) -> their starting temperature [K]
-    (NaN: keep the value LIGGGHTS holds). The contacts present at the start (overlaps as
+    (NaN: keep the value LIGGGHTS holds); ``T_of_type``: the same by atom type, where it depends on
+    the type alone (else None). The contacts present at the start (overlaps as
     placed, a script's read_restart of a settled bed) are not collisions: open and enduring.
     ``resume``: a checkpoint's state (pyhost.checkpoint) to continue from, its logs appended to.
     """
 
     def __init__(self, scene, dem: Dem, out: Path, *, type_material, groups, walls, initial_T, fluid=None,
                  end: float | None = None, progress_every: float = 5.0, keep_all: np.ndarray | None = None,
-                 resume: dict | None = None):
+                 T_of_type: np.ndarray | None = None, resume: dict | None = None):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
         self.materials = script_dem_contacts(scene, dem) if scene.scripted else list(scene.materials.values())
         self.type_material = np.asarray(type_material, int)
         self.initial_T = initial_T
+        self.T_of_type = T_of_type       # initial_T by type alone, where it is (a script's scene) [K]
         self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
-        self.before = None
+        self.before = None               # box scenes: (time, step, particles) before the chunk under way
         self.capacity = np.array([m.heat_capacity for m in self.materials])
         self.t0_step = dem.step
         self.t = dem.step * dem.dt
@@ -181,10 +183,10 @@ class Coupling:
         while n > 0:
             step = self.dem.step - self.t0_step
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
-            if self.keep_all is not None and (self.before is None or self.before[4] != self.dem.step):
-                self.note_before(self.dem.atoms(False))
+            if self.keep_all is not None and (self.before is None or self.before[1] != self.dem.step):
+                self.before = (self.t, self.dem.step, self.dem.keep_snapshot())
             self.dem.run(chunk)
-            if self.keep_all is not None and self.dem.count() < len(self.before[1]):
+            if self.keep_all is not None and self.dem.count() < self.before[2]:
                 self.lost()
             n -= chunk
             self.run_left = n
@@ -192,9 +194,8 @@ class Coupling:
             step += chunk
             self.t = self.dem.step * self.dem.dt
             due = {name: k and step % k == 0 for name, k in self.every.items()}
-            atoms = self.collisions.after_chunk(due) if self.collisions is not None else None
-            if atoms is not None and self.keep_all is not None:
-                self.note_before(atoms)             # spares a gather of all atoms under MPI
+            if self.collisions is not None:
+                self.collisions.after_chunk(due)
             if due["couple"]:
                 for effect in self.effect_list:
                     effect.couple()
@@ -225,15 +226,12 @@ class Coupling:
             print(f"frames and history rows every {n} steps ({n * self.dem.dt:.4g} s; {source})")
         return n
 
-    def note_before(self, atoms) -> None:
-        """The particles before the next chunk (time, ids, positions, velocities, step): what
-        a report of lost particles says of them."""
-        self.before = (self.t, atoms.id.copy(), atoms.x.copy(), atoms.v.copy(), self.dem.step)
-
     def lost(self):
-        """A box scene lost particles (through an open face, a soft wall, or blown out)."""
-        gone = np.setdiff1d(self.before[1], self.dem.atoms(False).id)
-        raise particles_lost(self.scene, gone, self.before[:4], self.dem.step * self.dem.dt, self.keep_all)
+        """A box scene lost particles (through an open face, a soft wall, or blown out): a
+        report from each rank's copy of its particles before the chunk (``Dem.keep_snapshot``)."""
+        ids, x, v = self.dem.snapshot()
+        gone = np.setdiff1d(ids, self.dem.atoms(False).id)
+        raise particles_lost(self.scene, gone, (self.before[0], ids, x, v), self.dem.step * self.dem.dt, self.keep_all)
 
     def write_frame(self) -> None:
         for effect in self.effect_list:

@@ -171,7 +171,7 @@ def user_script(scene):
     return dict(type_material=type_material,
                 groups=(names, lambda atoms: type_material[np.minimum(atoms.type, top)]),
                 initial_T=lambda atoms, new: T_material[type_material[np.minimum(atoms.type[new], top)]],
-                walls_of=walls_of)
+                T_of_type=np.where(type_material >= 0, T_material[type_material], np.nan), walls_of=walls_of)
 
 
 def driven_time(scene) -> float:

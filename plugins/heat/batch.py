@@ -18,6 +18,7 @@ import numpy as np
 
 from plugins.heat import MODEL_NAMES, MODELS, Pair, collide, effective_modulus
 from plugins.heat.comparison import COMPARISON, DemPair
+from plugins.heat.exchange import exchange_heat, temperature_difference
 from plugins.heat.fast import collide_fast
 
 
@@ -86,3 +87,20 @@ def side_heat(models, path: str, materials: list, mat_i, mat_j, R_i, R_j, v0, dT
     """{model: Q [J]} of each side model on the same collisions (``evaluate`` with each);
     side models only report, they move no heat and give no restitution."""
     return {m: evaluate(m, path, materials, mat_i, mat_j, R_i, R_j, v0, dT)[0] for m in models}
+
+
+def move_heat(models, path: str, materials: list, mat_i, mat_j, R_i, R_j, v0, T, C, i, j, T_wall=None, shift=None):
+    """Collisions in their order, their heat moved (``exchange_heat``: T [K] changed in place,
+    C = m c [J/K] per particle; i, j particle indices, j >= WALL_BASE a wall) by the first of
+    ``models``, the others as side columns at the same temperature differences (nothing moved).
+    Other arguments as ``evaluate``. Returns the collisions' columns (Q [J] moved from i to j,
+    e [-], t_coll [s] and Q_<model> of each side model), whether each is outside the models'
+    range (``evaluate_flagged``), and how many were capped."""
+    args = (path, materials, mat_i, mat_j, R_i, R_j, v0, np.ones(len(v0)))
+    G, e, t_coll, flagged = evaluate_flagged(models[0], *args)              # Q per kelvin [J/K]
+    side = {}
+    if len(models) > 1:
+        dT = temperature_difference(T, i, j, T_wall) + (0.0 if shift is None else shift)
+        side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}
+    moved, capped, _ = exchange_heat(T, C, i, j, G, T_wall, shift)
+    return dict(Q=moved, e=e, t_coll=t_coll, **side), flagged, capped

@@ -16,15 +16,22 @@ present at the start (or a restart) are open and enduring, not collisions.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from plugins.dem.impulse import restitution_impulse
-from plugins.heat.batch import evaluate_flagged, side_heat
-from plugins.heat.exchange import exchange_heat, temperature_difference
+from plugins.heat.batch import move_heat
 from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.effects import Effect
-from pyhost.engines.events import BEGIN, END
+from pyhost.effects.rank_heat import RankHeat, on_rank
+from pyhost.engines.atoms import Atoms
+from pyhost.engines.events import BEGIN, END, join_moved
 from pyhost.output import ColumnLog, CsvLog, collision_kinds
+
+ON_RANKS = True
+"""Whether a harvest under MPI moves collision heat on each rank (``harvest_on_ranks``) where
+it can; False: on rank 0 alone (``harvest_partly``), which tests compare it with."""
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 
@@ -39,6 +46,7 @@ class CollisionHeat(Effect):
         self.t_coll_of = {}                      # (key, begin step) -> t_coll [s] of pair collisions under heat/gran
         self.restitution = scene.effects.restitution_feedback and loop.heat
         self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
+        self.gathered = None                     # a harvest's log rows, while harvest_on_ranks gathers them
         columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
         mark = (logs or {}).get("collisions")
         self.log = (ColumnLog(loop.out / "collisions", collision_kinds(columns), mark)
@@ -69,19 +77,18 @@ class CollisionHeat(Effect):
         self.wall_material = np.array([w.material for w in walls], int)
         self.dem.event_walls(self.wall_index)
 
-    def after_chunk(self, due: dict):
-        """The contacts' work at the end of a DEM chunk: the events harvested, if due. Returns
-        the atoms it gathered (None if it gathered none)."""
+    def after_chunk(self, due: dict) -> None:
+        """The contacts' work at the end of a DEM chunk: the events harvested, if due."""
         loop = self.loop
         if self.harvest_alone(due):
-            self.harvest_partly()
-            return None
-        if not self.wants_harvest(due):
-            return None
-        atoms = self.dem.atoms(loop.heat)
-        loop.track_particles(atoms)
-        self.harvest(atoms, final=bool(due["checkpoint"]))
-        return atoms
+            if ON_RANKS and loop.heat and not self.restitution:
+                self.harvest_on_ranks()
+            else:
+                self.harvest_partly()
+        elif self.wants_harvest(due):
+            atoms = self.dem.atoms(loop.heat)
+            loop.track_particles(atoms)
+            self.harvest(atoms, final=bool(due["checkpoint"]))
 
     def wants_harvest(self, due: dict) -> bool:
         """Whether this chunk's end needs the events taken now: a harvest, a frame or a
@@ -112,13 +119,14 @@ class CollisionHeat(Effect):
     def close(self) -> None:
         self.log.close()
 
-    def flag_outside_range(self, flagged, v0) -> None:
-        """Collisions the contact models do not cover (plugins.heat.validity, as ``collide`` flags
-        them): counted in summary.json (outside_model_range), said once; their heat is moved."""
-        self.totals["outside_model_range"] += int(flagged.sum())
-        if "outside_model_range" not in self.warned:
+    def flag_outside_range(self, count: int, v_max: float) -> None:
+        """``count`` collisions the contact models do not cover (plugins.heat.validity, as
+        ``collide`` flags them; the fastest at v_max [m/s]): counted in summary.json
+        (outside_model_range), said once; their heat is moved."""
+        self.totals["outside_model_range"] += count
+        if count and "outside_model_range" not in self.warned:
             self.warned.add("outside_model_range")
-            print(f"warning: a collision at v0 = {float(np.max(v0[flagged])):.4g} m/s is outside the contact models' "
+            print(f"warning: a collision at v0 = {v_max:.4g} m/s is outside the contact models' "
                   "range (indentation beyond the smaller radius, or an output overflows): its heat is the models' "
                   "extrapolation; such collisions are counted in summary.json as outside_model_range")
 
@@ -137,10 +145,11 @@ class CollisionHeat(Effect):
 
     def harvest_alone(self, due) -> bool:
         """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran:
-        then only the colliding atoms are gathered to rank 0 (``harvest_partly``). Nothing but
-        the host changes a temperature then, and each atom's heat content in the balance is
-        brought up to date when it is next seen."""
-        return (self.dem.link is not None and not self.dem.events.window and self.loop.keep_all is None
+        then each rank moves the heat of its own collisions (``harvest_on_ranks``), or with
+        restitution feedback only the colliding atoms are gathered to rank 0
+        (``harvest_partly``). Nothing but the host changes a temperature then, and each atom's
+        heat content in the balance is brought up to date when it is next seen."""
+        return (self.dem.link is not None and not self.dem.events.window
                 and due["harvest"] and not any(v for k, v in due.items() if k != "harvest"))
 
     def harvest_partly(self) -> None:
@@ -153,6 +162,52 @@ class CollisionHeat(Effect):
         atoms = self.dem.atoms_of(ids, self.loop.heat)
         self.loop.track_particles(atoms, departures=False)
         self.harvest(atoms, ev=ev)
+
+    def harvest_on_ranks(self) -> None:
+        """A harvest under MPI with collision heat, no restitution feedback and no fix
+        heat/gran: each rank moves the heat of the collisions it can alone, on its own atoms
+        (``pyhost.effects.rank_heat``); rank 0 moves those left over on the atoms of their events
+        only (``harvest``), counts all, and writes all rows in the serial order."""
+        loop, balance = self.loop, self.loop.balance
+        models = self.scene.effects.heat_models
+        setup = RankHeat(loop.materials, loop.type_material, loop.capacity, tuple(models),
+                         self.scene.effects.heat_path, self.T_wall, self.wall_material, self.dem.dt,
+                         np.packbits(balance.seen), len(balance.seen), loop.T_of_type)
+        parts = self.dem.each_rank(on_rank, setup)
+        rows = []
+        for p in parts:
+            if len(p["new"][0]):   # inserted atoms a rank gave their starting temperature: they come in
+                balance.track(Atoms(p["new"][0], None, None, p["new"][3], p["new"][1], p["new"][2], p["new"][4]),
+                              departures=False)
+        for p in parts:
+            if len(p["ids"]):      # the heat contents changed on the ranks, as a partial harvest sees them
+                before = Atoms(p["ids"], None, None, None, p["mass"], p["type"], p["T_before"])
+                balance.track(before, departures=False)
+                balance.track(dataclasses.replace(before, T=p["T_after"]), departures=False)
+            self.totals["capped"] += p["capped"]
+            if p["still"]:
+                self.totals["contacts_without_impact"] = self.totals.get("contacts_without_impact", 0) + p["still"]
+            if p["flagged"]:
+                self.flag_outside_range(p["flagged"], p["v_flagged"])
+            rows.append((p["cols"], p["step"], p["jj"]))
+        ev, self.dem.events.joined = join_moved(np.concatenate([p["events"] for p in parts]))
+        atoms = None
+        if np.any(ev["kind"] == BEGIN):
+            ids = np.unique(np.r_[ev["i"], ev["j"][~ev["wall"]]])
+            atoms = self.dem.atoms_of(ids, loop.heat)
+            loop.track_particles(atoms, departures=False)
+        self.gathered = rows
+        try:
+            self.harvest(atoms, ev=ev)
+        finally:
+            self.gathered = None
+        step, j = (np.concatenate([r[k] for r in rows]) for k in (1, 2))
+        cols = {k: np.concatenate([r[0][k] for r in rows]) for k in rows[0][0]}
+        order = np.lexsort((j, cols["i"], j >= WALL_BASE, step))
+        self.totals["collisions_moved_on_ranks"] = (self.totals.get("collisions_moved_on_ranks", 0)
+                                                    + sum(len(p["step"]) for p in parts))
+        if len(order):
+            self.record({k: v[order] for k, v in cols.items()})
 
     def harvest(self, atoms, final: bool = False, ev=None) -> None:
         """The contact events recorded inside LIGGGHTS since the last harvest: each begun
@@ -224,8 +279,10 @@ class CollisionHeat(Effect):
         # order in memory (a restart or another number of ranks changes it)
         begin = begin[np.lexsort((begin["j"], begin["i"], begin["wall"], begin["step"]))]
         if len(begin):
-            t_coll, e = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["step"] * self.dem.dt,
-                                     T_begin=begin["T"])
+            cols = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["step"] * self.dem.dt,
+                                T_begin=begin["T"])
+            self.record(cols, begin["step"], begin["j"])
+            t_coll, e = cols["t_coll"], cols["e"]
             if self.dem.events.window:          # each pair collision's model time, until its flux history comes
                 pair = ~begin["wall"]
                 keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
@@ -285,48 +342,53 @@ class CollisionHeat(Effect):
         np.add.at(atoms.T, b, q / self.loop.C[b])
         self.totals["heat_gran_undone"] += float(np.abs(q).sum())
 
-    def collide(self, atoms, ids_i, j, v0, time, T_begin=None):
+    def collide(self, atoms, ids_i, j, v0, time, T_begin=None) -> dict:
         """Collisions of particles ``ids_i`` with partners ``j`` (ids, or WALL_BASE + wall) at
-        impact speeds v0 [m/s], begun at ``time`` [s]: the plugin's heat moved in this order, the
-        totals and the collision log. Returns each collision's model duration t_coll [s] and
-        restitution e (zeros without particle temperatures). ``T_begin`` (n, 2) [K]: the two
-        temperatures when each began (NaN: as now), where something else (a fix heat/gran)
-        changed them since: each collision's temperature difference is the one it began with,
-        plus what earlier collisions of this batch moved."""
+        impact speeds v0 [m/s], begun at ``time`` [s]: the plugin's heat moved in this order
+        (``plugins.heat.batch.move_heat``). Returns their columns of the collision log (Q, e
+        and t_coll zero without particle temperatures): ``record`` counts and writes them.
+        ``T_begin`` (n, 2) [K]: the two temperatures when each began (NaN: as now), where
+        something else (a fix heat/gran) changed them since: each collision's temperature
+        difference is the one it began with, plus what earlier collisions of this batch moved."""
         i = atoms.index(ids_i)
         wall, jl, mj, R_j, _ = self.partners(atoms, i, j)
         mi, R_i = self.loop.materials_of(atoms.type[i]), atoms.radius[i]
-        rows = np.arange(len(i))
         models = self.scene.effects.heat_models
-        model = models[0] if models else "none"
-        moved = e = t_coll = np.zeros(len(rows))
-        side = {}
+        heat = dict.fromkeys(("Q", "e", "t_coll"), np.zeros(len(i)))
         if self.loop.heat:
             shift = None
             if T_begin is not None:         # (T_i - T_j) then minus now, before this batch
                 drift = T_begin - np.column_stack([atoms.T[i], np.where(wall, np.nan, atoms.T[np.where(wall, i, jl)])])
                 shift = np.nan_to_num(drift[:, 0]) - np.where(wall, 0.0, np.nan_to_num(drift[:, 1]))
-            args = (self.scene.effects.heat_path, self.loop.materials, mi, mj, R_i, R_j, v0, np.ones(len(rows)))
-            G, e, t_coll, flagged = evaluate_flagged(model, *args)              # Q per kelvin [J/K]
-            if flagged.any():
-                self.flag_outside_range(flagged, v0)
-            if len(models) > 1:         # side columns: the same collisions at the same dT, nothing moved
-                dT = temperature_difference(atoms.T, i, jl, self.T_wall) + (0.0 if shift is None else shift)
-                side = {f"Q_{m}": g * dT for m, g in side_heat(models[1:], *args).items()}
-            moved, capped, from_walls = exchange_heat(atoms.T, self.loop.C, i, jl, G, self.T_wall, shift)
+            heat, flagged, capped = move_heat(models, self.scene.effects.heat_path, self.loop.materials, mi, mj, R_i,
+                                              R_j, v0, atoms.T, self.loop.C, i, jl, self.T_wall, shift)
             self.totals["capped"] += capped
-            self.totals["heat_from_walls"] += from_walls
-            self.totals["heat_moved"] += float(np.abs(moved[~wall]).sum())
+            if flagged.any():
+                self.flag_outside_range(int(flagged.sum()), float(np.max(v0[flagged])))
+        return dict(time=time, i=ids_i, j=np.where(wall, 0, j), wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0,
+                    model=np.full(len(i), models[0] if models else "none"), **heat)
+
+    def record(self, cols: dict, step=None, j=None) -> None:
+        """Collisions' columns (``collide``), in the order their heat was moved: counted in the
+        totals (heat between particles as sum |Q|, the walls' heat summed in order) and written
+        to the collision log. While ``harvest_on_ranks`` gathers the rows of a harvest (with
+        each collision's ``step`` and partner ``j``, id or wall code, to order them), kept."""
+        if self.gathered is not None:
+            self.gathered.append((cols, step, j))
+            return
+        wall = cols["wall"] > 0
+        if self.loop.heat:
+            Q = cols["Q"]
+            q_walls = Q[wall]
+            self.totals["heat_from_walls"] += 0.0 - float(np.cumsum(q_walls)[-1]) if len(q_walls) else 0.0
+            self.totals["heat_moved"] += float(np.abs(Q[~wall]).sum())
             by_model = self.heat_by_model()
-            for m, q in zip(models, [moved] + list(side.values())):
-                by_model[m] += float(np.abs(q[~wall]).sum())
-        self.totals["collisions"] += len(rows)
+            for k, m in enumerate(self.scene.effects.heat_models):     # the first moved the heat
+                by_model[m] += float(np.abs(cols["Q" if k == 0 else f"Q_{m}"][~wall]).sum())
+        self.totals["collisions"] += len(wall)
         self.totals["particle_wall"] += int(wall.sum())
         self.totals["particle_particle"] += int((~wall).sum())
-        self.log.write_columns(time=time, i=ids_i, j=np.where(wall, 0, j),
-                                      wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0, Q=moved, e=e,
-                                      t_coll=t_coll, model=np.full(len(rows), model), **side)
-        return t_coll, e
+        self.log.write_columns(**cols)
 
     def heat_by_model(self) -> dict:
         """Heat between particles [J], sum of |Q| over collisions, of each heat model: the one

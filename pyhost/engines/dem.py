@@ -18,16 +18,16 @@ the arrays are LIGGGHTS' own memory and nothing needs to go back.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from pyhost.collisions import WALL_BASE
+from pyhost.engines.atoms import Atoms, local_view
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
 from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
-                                  local_values, put_by_id, set_random_states, write_local)
+                                  local_snapshot, local_values, put_by_id, set_random_states, write_local)
 from pyhost.script import Command, ScriptError, ScriptInfo
 
 FLUID_FIX = "collheat_fluid"
@@ -36,27 +36,6 @@ HEAT_GRAN_WINDOW = 200
 heat/gran moved during a collision's model duration t_coll is taken back from them, so
 t_coll up to this many steps is taken back whole (a longer one: its first 200 steps, counted
 as heat_gran_undo_cut)."""
-
-
-@dataclass(frozen=True)
-class Atoms:
-    """The particles now, local order (SI): ids, x (n, 3) [m], v (n, 3) [m/s], radius [m],
-    mass [kg], type, T (writable view of LIGGGHTS' Temp [K], or None)."""
-
-    id: np.ndarray
-    x: np.ndarray
-    v: np.ndarray
-    radius: np.ndarray
-    mass: np.ndarray
-    type: np.ndarray
-    T: np.ndarray | None
-
-    def index(self, ids) -> np.ndarray:
-        """Local index of each atom id (-1 for ids not here)."""
-        ids = np.asarray(ids, np.int64)
-        lookup = np.full(int(max(self.id.max(initial=0), ids.max(initial=0))) + 1, -1, np.int64)
-        lookup[self.id] = np.arange(len(self.id))
-        return lookup[ids]
 
 
 class Dem:
@@ -222,9 +201,7 @@ class Dem:
     def atoms(self, temperature: bool = True) -> Atoms:
         lmp = self.lmp
         if self.link is None:
-            T = lmp.temperature() if temperature and lmp.nlocal else (np.zeros(0) if temperature else None)
-            return Atoms(lmp.atom("id").astype(np.int64), lmp.atom("x"), lmp.atom("v"), lmp.atom("radius"),
-                         lmp.atom("rmass"), lmp.atom("type"), T)
+            return local_view(lmp, temperature)
         if self._all_current(temperature):
             return self._pending[0]     # no run or command since: as serially, the same arrays
         self._order("atoms", temperature)
@@ -279,6 +256,40 @@ class Dem:
                   for k in names]
         self.link.order("write", FLUID_FIX)
         write_local(self.lmp, *self.link.scatter(list(zip(*pieces))), force_fix=FLUID_FIX, rows=self._rows)
+
+    @collective
+    def keep_snapshot(self) -> int:
+        """Every rank keeps a copy of its atoms' ids, positions [m] and velocities [m/s] (what a
+        report of lost particles says of them: ``snapshot``); returns the number of particles.
+        Under MPI nothing but the counts goes to rank 0."""
+        if self.link is None:
+            self._snapshot = local_snapshot(self.lmp)
+            return len(self._snapshot[0])
+        self._order("keep_snapshot")
+        self._snapshot = local_snapshot(self.lmp)
+        return int(sum(self.link.gather(len(self._snapshot[0]))))
+
+    @collective
+    def snapshot(self) -> tuple:
+        """The copies of ``keep_snapshot`` (ids, x, v) of all ranks, gathered."""
+        if self.link is None:
+            return self._snapshot
+        self._order("snapshot")
+        cols, _ = gather_arrays(self.link.comm, self._snapshot)
+        return cols
+
+    @collective
+    def each_rank(self, func, *args) -> list:
+        """``func(atoms, events, comm, *args)`` (a module-level function: the followers import it
+        by name) on every rank, on its own atoms (``local_view``: LIGGGHTS' memory, T writable)
+        and contact events; the ranks' results in rank order (serially: the one result, in a
+        list, comm None). What the host changed in gathered atoms goes back first."""
+        if self.link is None:
+            return [func(local_view(self.lmp), self.events, None, *args)]
+        self._order("each_rank", func, args)
+        mine = func(local_view(self.lmp), self.events.local, self.link.comm, *args)
+        self._pending = None            # func may change the atoms' Temp: a gathered copy is out of date
+        return self.link.gather(mine)
 
     @collective
     def per_atom(self, names) -> tuple:

@@ -73,7 +73,7 @@ class DemEngine(Protocol):
         """(lo [m], hi [m], periodic flags) of the domain."""
 
     def atoms(self, temperature: bool = True):
-        """Every particle now (``pyhost.engines.dem.Atoms``), with a writable T [K] if asked;
+        """Every particle now (``pyhost.engines.atoms.Atoms``), with a writable T [K] if asked;
         writes into T and v reach the engine before its next step."""
 
     def atoms_of(self, ids, temperature: bool = True):
@@ -84,6 +84,18 @@ class DemEngine(Protocol):
 
     def set_force(self, force) -> None:
         """The external force [N] on each atom (the fluid's), kept until set again."""
+
+    def keep_snapshot(self) -> int:
+        """Keep a copy of every particle's id, position [m] and velocity [m/s] where it lives
+        (each MPI rank its own); returns the number of particles."""
+
+    def snapshot(self) -> tuple:
+        """The copies of ``keep_snapshot``: (ids, x, v) of all particles (a report of lost ones)."""
+
+    def each_rank(self, func, *args) -> list:
+        """``func(atoms, events, comm, *args)`` run where the particles live: each MPI rank on its
+        own atoms (``Atoms`` with T writable into the engine) and contact events, serially once
+        with comm None; the results in rank order."""
 
     def per_atom(self, names) -> tuple:
         """Per-atom arrays by name ("id", "f", "torque"), for a checkpoint."""

@@ -21,6 +21,8 @@ import time
 
 import numpy as np
 
+from pyhost.engines.atoms import local_view
+
 ROOT = 0
 
 
@@ -43,6 +45,11 @@ def local_atoms(lmp, temperature: bool) -> tuple:
     if temperature:
         parts.append(_plain(lmp.temperature()) if lmp.nlocal else np.zeros(0))
     return tuple(parts)
+
+
+def local_snapshot(lmp) -> tuple:
+    """Copies of this rank's atoms' ids, x and v (``Dem.keep_snapshot``)."""
+    return tuple(_plain(lmp.atom(name).copy()) for name in ("id", "x", "v"))
 
 
 def local_atoms_of(lmp, ids, temperature: bool) -> tuple:
@@ -253,6 +260,17 @@ class Follower:
         mine = ask(self.events, name, args)
         if name in GATHERED:
             self.comm.gather(mine, root=ROOT)
+
+    def do_keep_snapshot(self) -> None:
+        self.snap = local_snapshot(self.lmp)
+        self.comm.gather(len(self.snap[0]), root=ROOT)
+
+    def do_snapshot(self) -> None:
+        gather_arrays(self.comm, self.snap)
+
+    def do_each_rank(self, func, args) -> None:
+        """``Dem.each_rank``: ``func`` on this rank's atoms and events, its result to rank 0."""
+        self.comm.gather(func(local_view(self.lmp), self.events, self.comm, *args), root=ROOT)
 
     def do_write(self, force_fix) -> None:
         write_local(self.lmp, *self.comm.scatter(None, root=ROOT), force_fix=force_fix, rows=getattr(self, "rows", None))

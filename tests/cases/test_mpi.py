@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import FLOOR_STL, POUR_SCRIPT, STOPPER, glass_toml
 
@@ -116,9 +117,11 @@ POUR = "\n".join(line for line in POUR_SCRIPT.splitlines()
 
 COUNT_PARTIAL = """
 import atexit, sys
+import pyhost.effects.collisions as collisions
 import pyhost.engines.dem as dem
 from pyhost.cli import main
 from mpi4py import MPI
+collisions.ON_RANKS = False          # rank 0 moves all collision heat
 if MPI.COMM_WORLD.Get_rank() == 0:
     calls, real = [0], dem.Dem.atoms_of
     def atoms_of(self, *args, **kwargs):
@@ -132,8 +135,9 @@ sys.exit(main(sys.argv[1:]))
 
 def test_harvests_between_frames_gather_only_the_colliding_atoms(tmp_path):
     """A user's pour (300 spheres of two sizes onto an STL floor, hot type 1 and cold type 2,
-    no fix heat/gran) on two ranks, a frame only at the end: rank 0's harvests every 1,000
-    steps gather the atoms of their events only (Dem.atoms_of), not every atom. Against the
+    no fix heat/gran) on two ranks, a frame only at the end, rank 0 moving all collision heat
+    (as with restitution feedback): its harvests every 1,000 steps gather the atoms of their
+    events only (Dem.atoms_of), not every atom. Against the
     same run with a frame at every harvest (every atom gathered then): the same pour (the
     host changes no velocity here), so the same collisions, contacts without impact and
     particles, heat moved to 1e-12 and each balance to 1e-12."""
@@ -169,6 +173,65 @@ pictures = false
     for r in (partly, whole):
         assert r["status"] == "completed" and abs(r["energy_balance_error"]) < 1e-12
     assert partly["heat_moved"] == pytest.approx(whole["heat_moved"], rel=1e-12)
+
+
+ON_RANKS = """
+import os, sys
+import pyhost.effects.collisions as collisions
+from pyhost.cli import main
+collisions.ON_RANKS = os.environ["ON_RANKS"] == "1"
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_collision_heat_moved_on_each_rank_agrees_with_rank_0_moving_it(tmp_path):
+    """The pour on two ranks cut across x (``processors 2 1 1``: both ranks pour), a frame only
+    at the end. Each rank moves the heat of its own collisions (pyhost.effects.rank_heat),
+    against rank 0 moving all in their order. The pour is the same (the host changes no
+    velocity), so the collisions are the same: times, ids, impact speeds, e and t_coll equal.
+    A particle whose collisions of one batch were moved in two places met them out of order:
+    each collision's heat within 1e-5 of the largest collision's (measured 1.8e-6, 2e-12 J),
+    heat moved within 1e-6 (4.8e-8), mean temperatures within 1e-9 K (1.5e-11 K, of a 2.7e-4 K
+    change). Most collisions are moved on their rank (measured 9,661 of 9,974)."""
+    case = tmp_path / "case"
+    case.mkdir()
+    (case / "floor.stl").write_text(FLOOR_STL)
+    (case / "in.pour").write_text(POUR.replace("atom_style granular\n", "atom_style granular\nprocessors 2 1 1\n"))
+    (case / "case.toml").write_text(f"""[dem]
+script = "in.pour"
+[effects]
+contact_heat = "A"
+{glass_toml("hot", "[1]", "temperature = 400.0")}{glass_toml("cold", "[2]", "temperature = 300.0")}[output]
+every = 1.0
+vtk = false
+pictures = false
+""")
+    out = {}
+    for on in ("1", "0"):
+        r = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", sys.executable, "-c", ON_RANKS, "run",
+                            str(case), "--out", str(tmp_path / on)], capture_output=True, text=True,
+                           env=dict(ENV, ON_RANKS=on), timeout=600)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        out[on] = json.loads((tmp_path / on / "summary.json").read_text())
+    ranks, alone = out["1"], out["0"]
+    print({k: (ranks.get(k), alone.get(k)) for k in ("collisions", "collisions_moved_on_ranks", "heat_moved",
+                                                     "energy_balance_error")})
+    assert grid(tmp_path / "1") == "2 by 1 by 1"
+    assert ranks["collisions"] == alone["collisions"] > 5000
+    assert ranks["collisions_moved_on_ranks"] > 0.8 * ranks["collisions"] and "collisions_moved_on_ranks" not in alone
+    assert ranks["heat_moved"] == pytest.approx(alone["heat_moved"], rel=1e-6)
+    for r in (ranks, alone):
+        assert r["status"] == "completed" and abs(r["energy_balance_error"]) < 1e-12
+    a, b = (np.genfromtxt(tmp_path / on / "collisions.csv", delimiter=",", names=True, dtype=None, encoding=None)
+            for on in ("1", "0"))
+    for column in ("time", "i", "j", "wall", "v0", "e", "t_coll"):
+        assert np.array_equal(a[column], b[column]), column
+    dQ = np.abs(a["Q"] - b["Q"]).max()
+    print(f"largest heat difference {dQ:.3g} J, {dQ / np.abs(b['Q']).max():.3g} of the largest heat")
+    assert dQ <= 1e-5 * np.abs(b["Q"]).max()
+    a, b = (np.genfromtxt(tmp_path / on / "history.csv", delimiter=",", names=True) for on in ("1", "0"))
+    for column in ("T_mean", "T_group0", "T_group1"):
+        assert np.nanmax(np.abs(a[column] - b[column])) < 1e-9, column
 
 
 def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):

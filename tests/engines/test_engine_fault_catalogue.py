@@ -2,6 +2,7 @@
 failed simulation, docs/exit-codes.md) and one line saying what failed and why. Fluid
 solver faults are simulated with small programs posing as collheatFoam (COLLHEAT_SOLVER)."""
 import os
+import shutil
 import stat
 import subprocess
 import sys
@@ -17,12 +18,16 @@ BASE = tomllib.loads((ROOT / "cases" / "two-particles" / "case.toml").read_text(
 STEEL = BASE["materials"]["steel"]
 
 
-def run(tmp_path, scene, env=None):
+def run(tmp_path, scene, env=None, ranks=1):
     case = tmp_path / "case"
     case.mkdir()
     (case / "case.toml").write_text(tomli_w.dumps(scene))
-    return subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--out", str(tmp_path / "out")],
-                          capture_output=True, text=True, cwd=ROOT, env={**os.environ, **(env or {})}, timeout=120)
+    cmd = [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(tmp_path / "out")]
+    if ranks > 1:
+        cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
+        env = dict(env or {}, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    return subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env={**os.environ, **(env or {})},
+                          timeout=120)
 
 
 def one_particle(speed, youngs=2e8, walls=(), dem_step=2e-7):
@@ -35,15 +40,20 @@ def one_particle(speed, youngs=2e8, walls=(), dem_step=2e-7):
 
 
 def assert_failed(r, *words):
+    """Exit 3 and the error as the last line (under mpirun, the last before mpirun's own)."""
     assert r.returncode == 3, r.stderr[-2000:]
-    line = r.stderr.strip().splitlines()[-1]
+    line = r.stderr.split("\n-----", 1)[0].strip().splitlines()[-1]
     assert line.startswith("error: simulation failed") and "Traceback" not in r.stderr
     for w in words:
         assert w in r.stderr, (w, r.stderr[-2000:])
 
 
-def test_particle_leaving_through_an_open_face(tmp_path):
-    r = run(tmp_path, one_particle(30.0))
+@pytest.mark.parametrize("ranks", [1, pytest.param(2, marks=pytest.mark.skipif(
+    shutil.which("mpirun") is None, reason="no mpirun: tools/setup.sh --engines"))])
+def test_particle_leaving_through_an_open_face(tmp_path, ranks):
+    """Also on two ranks, where each keeps its own particles' positions before each chunk and
+    rank 0 gathers them only for the report."""
+    r = run(tmp_path, one_particle(30.0), ranks=ranks)
     assert_failed(r, "ParticlesLost", "ids [1]", "v = [30.0, 0.0, 0.0]", "open at xhi")
     assert "stopped at t = " in (tmp_path / "out" / "summary.json").read_text()
 

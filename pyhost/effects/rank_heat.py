@@ -1,0 +1,158 @@
+"""Collision heat on each MPI rank, for the rank's own particles (``CollisionHeat.harvest_on_ranks``).
+
+Under mpirun every rank records the contacts of its own atoms (``pyhost.engines.events``): a
+pair on the rank owning the smaller id, a wall contact on the particle's owner. At a harvest
+that needs nothing else (no frame, fluid exchange or checkpoint), each rank takes its events
+and moves the heat of its collisions, in their order, into LIGGGHTS' ``Temp`` of its own atoms
+(``on_rank``, run on every rank). A partner owned by another rank (a pair across the cut)
+takes part with its temperature and heat capacity as its owner has them at the harvest's
+start, and the heat it received goes to its owner, which adds it to the particle's
+temperature once its own collisions are moved. Rank 0 gets the collisions' log rows, the
+balance's heat contents of the atoms whose temperature changed, a few counts, and the events
+left over, which it moves itself on the atoms of those events only (``CollisionHeat.harvest``):
+
+- a collision of a particle of a type without material, or one rank 0 has not seen yet
+  (inserted since its last look) when its starting temperature is not its type's (box
+  scenes; a script's particle takes its material's temperature on its rank);
+- a collision whose particle is no longer on the rank that recorded it (it moved to
+  another rank, or left the simulation, before the harvest);
+- a contact that moved between ranks while open (``moved``: rank 0 joins the two halves).
+
+Each collision's heat leaves one body and enters the other, so the particles' sum(m c T)
+changes only by the walls' heat, as serially. Heat moves collision after collision with the
+temperatures of that moment; a particle whose collisions of one batch are moved in two places
+(two ranks, or a rank and rank 0) sees those of the other place's after its own instead of in
+their order. The heat of such a collision differs from the serial order's by the other
+collisions' share of its temperature difference (in tests/cases/test_mpi.py: at most
+1e-9 of a collision's heat). Rank 0 writes the log rows of all in the serial order (step,
+walls last, ids). SI units.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from plugins.heat.batch import move_heat
+from plugins.heat.exchange import WALL_BASE
+from pyhost.engines.events import BEGIN
+
+
+@dataclass(frozen=True)
+class RankHeat:
+    """What each rank needs to move collision heat (the host's view, sent with each harvest):
+    the scene's materials (real and DEM, ``plugins.heat.batch``), the material index of each
+    atom type (-1: none), the heat capacity of each material [J/(kg K)], the heat models (the
+    first moves heat, the others are side columns), the plugin's path, each wall's
+    temperature [K] (NaN: adiabatic) and real material (-1: the particle's), the DEM time
+    step [s], which ids rank 0 has seen (``np.packbits``, ``seen_count`` of them) and the
+    temperature [K] an atom of each type starts at (NaN: its own; None: rank 0 sets them)."""
+
+    materials: list
+    type_material: np.ndarray
+    capacity: np.ndarray
+    models: tuple
+    path: str
+    T_wall: np.ndarray
+    wall_material: np.ndarray
+    dt: float
+    seen: np.ndarray
+    seen_count: int
+    T_of_type: np.ndarray | None
+
+
+def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
+    """One rank's part of a harvest (collective: every rank calls it): its events taken, the
+    heat of its collisions moved into its ``atoms``' T (the engine's own memory, writable), the heat of partners on other ranks
+    sent to their owners. Returns the columns of those collisions' log rows with their
+    ``step`` and partner code ``jj`` (the order rank 0 sorts by), ``still`` (contacts begun
+    without an approach speed), ``capped``, ``flagged`` (outside the models' range) and
+    ``v_flagged`` (the fastest of those), the balance's ``ids``, ``mass`` [kg], ``type``,
+    ``T_before`` and ``T_after`` [K] of this rank's atoms whose temperature changed, the atoms
+    rank 0 had not seen, given their starting temperature here (``new``: ids, mass, type,
+    radius and the temperature they had before), and the
+    ``events`` left to rank 0. An END is dropped unless it moved between ranks: without
+    restitution feedback and fix heat/gran nothing reads it."""
+    allgather = comm.allgather if comm is not None else (lambda mine: [mine])     # (serially: one rank)
+    ev = events.take()
+    ids, types, T, mass, radius = atoms.id, atoms.type, atoms.T, atoms.mass, atoms.radius
+    nt = len(setup.type_material)
+    material = np.where(types < nt, setup.type_material[np.minimum(types, nt - 1)], -1)
+    wall, i, j = ev["wall"], ev["i"], ev["j"]
+    j_atom = np.where(wall, i, j)
+    top = int(max(ids.max(initial=0), i.max(initial=0), j_atom.max(initial=0))) + 1
+    local = np.full(top, -1, np.int64)
+    local[ids] = np.arange(len(ids))
+    seen = np.zeros(top, bool)
+    n = min(top, setup.seen_count)
+    seen[:n] = np.unpackbits(setup.seen, count=setup.seen_count)[:n].astype(bool)
+    begun = (ev["kind"] == BEGIN) & ~ev["moved"]
+    here_ids = np.zeros(top, bool)
+    here_ids[ids] = True
+    asked = np.unique(j_atom[begun & here_ids[i] & ~here_ids[j_atom]])     # partners on other ranks
+    wanted = np.unique(np.concatenate(allgather(asked)))
+    # atoms rank 0 has not seen yet (inserted since) among those of the events and those asked
+    # for: their material's temperature now, as rank 0 sets it when it first sees an atom
+    fresh = np.zeros(0, np.int64)
+    if setup.T_of_type is not None:
+        involved = np.zeros(top, bool)
+        involved[np.r_[i[begun], j_atom[begun], wanted[wanted < top]]] = True
+        fresh = np.flatnonzero(involved[ids] & ~seen[ids] & (material >= 0))
+        T_set = setup.T_of_type[np.minimum(types[fresh], len(setup.T_of_type) - 1)]
+        result_new = (ids[fresh], mass[fresh].copy(), types[fresh].copy(), radius[fresh].copy(), T[fresh].copy())
+        T[fresh] = np.where(np.isnan(T_set), T[fresh], T_set)
+        seen[ids[fresh]] = True
+    else:
+        result_new = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0, types.dtype), np.zeros(0), np.zeros(0))
+    ok = np.zeros(top, bool)            # here, seen by rank 0 (or as it will), of a type with material
+    ok[ids] = seen[ids] & (material >= 0)
+    have = local[wanted[wanted < top]] if len(wanted) else np.zeros(0, np.int64)
+    have = have[have >= 0]
+    have = have[ok[ids[have]]]
+    answers = allgather((ids[have], T[have].copy(), mass[have].copy(), radius[have].copy(), material[have]))
+    r_id, r_T, r_m, r_R, r_mat = (np.concatenate([a[k] for a in answers]) for k in range(5))
+    remote = np.full(max(top, int(r_id.max(initial=0)) + 1), -1, np.int64)
+    remote[r_id] = len(ids) + np.arange(len(r_id))
+    if len(remote) > top:
+        local, ok = np.r_[local, np.full(len(remote) - top, -1)], np.r_[ok, np.zeros(len(remote) - top, bool)]
+    li = local[i]
+    lj = np.where(local[j_atom] >= 0, local[j_atom], remote[j_atom])
+    here = begun & ok[i] & (wall | ok[j_atom] | (remote[j_atom] >= 0))
+    out = ev["moved"] | (begun & ~here)
+    go = np.flatnonzero(here)
+    still = go[~(ev["vn"][go] > 0)]
+    go = go[ev["vn"][go] > 0]
+    go = go[np.lexsort((j[go], i[go], wall[go], ev["step"][go]))]     # the order of the serial harvest
+    a, b, w = li[go], lj[go], wall[go]
+    # this rank's atoms, then the partners of other ranks: temperatures, capacities, radii, materials
+    T_all, R_all, mat_all = np.r_[T, r_T], np.r_[radius, r_R], np.r_[material, r_mat]
+    C_all = np.r_[mass, r_m] * setup.capacity[np.maximum(mat_all, 0)]
+    T_before = T.copy()
+    result = dict(events=ev[out], still=len(still), capped=0, flagged=0, v_flagged=0.0, new=result_new)
+    code = j[go] - WALL_BASE
+    mi, mb = mat_all[a], mat_all[b]
+    wm = setup.wall_material[np.where(w, code, 0)] if len(setup.wall_material) else np.full(len(go), -1)
+    mj = np.where(w, np.where(wm >= 0, wm, mi), mb)
+    if len(go):
+        heat, flagged, capped = move_heat(setup.models, setup.path, setup.materials, mi, mj, R_all[a],
+                                          np.where(w, np.inf, R_all[b]), ev["vn"][go], T_all, C_all, a,
+                                          np.where(w, j[go], b), setup.T_wall, None)
+        result.update(capped=capped, flagged=int(flagged.sum()),
+                      v_flagged=float(ev["vn"][go][flagged].max(initial=0.0)))
+    else:
+        heat = {k: np.zeros(0) for k in ("Q", "e", "t_coll")} | {f"Q_{m}": np.zeros(0) for m in setup.models[1:]}
+    T[:] = T_all[:len(ids)]
+    # the heat partners on other ranks received, to their owners, added after the owners' own
+    into = (~w) & (b >= len(ids))
+    sent = allgather((j[go][into], heat["Q"][into]))
+    for got_id, got_q in sent:
+        mine = (got_id < len(local)) & (local[np.minimum(got_id, len(local) - 1)] >= 0)
+        k = local[got_id[mine]]
+        np.add.at(T, k, got_q[mine] / C_all[k])       # (in the order sent: the rank, then the collision)
+    changed = np.flatnonzero(T != T_before)
+    result.update(ids=ids[changed], mass=mass[changed].copy(), type=types[changed].copy(),
+                  T_before=T_before[changed], T_after=T[changed].copy(), step=ev["step"][go], jj=j[go],
+                  cols=dict(time=ev["step"][go] * setup.dt, i=i[go], j=np.where(w, 0, j[go]),
+                            wall=np.where(w, code + 1, 0), v0=ev["vn"][go],
+                            model=np.full(len(go), setup.models[0]), **heat))
+    return result
