@@ -234,6 +234,46 @@ pictures = false
         assert np.nanmax(np.abs(a[column] - b[column])) < 1e-9, column
 
 
+def test_box_with_a_hot_wall_moves_heat_on_each_rank_as_rank_0_does(tmp_path):
+    """hot-cold-box --test closed in z by a wall at 500 K below and an adiabatic one above, on
+    two ranks (frames every 10,000 steps: nine of its ten harvests come alone): each rank
+    moving its own collisions' heat (particle-wall ones included) against rank 0 moving all.
+    The same 8,719 collisions; the walls' heat within 1e-9 (measured 2e-15), each
+    collision's heat within 1e-4 of the largest (7.2e-6), the balance to 1e-12."""
+    case = tmp_path / "box"
+    shutil.copytree(CASES / "hot-cold-box", case, ignore=shutil.ignore_patterns("output", "log.*"))
+    text = (case / "case.toml").read_text().replace("periodic = [true, true, true]", "periodic = [true, true, false]")
+    assert "periodic = [true, true, false]" in text
+    (case / "case.toml").write_text(text + """
+[[walls]]
+plane = "zlo"
+material = "steel"
+temperature = 500.0
+
+[[walls]]
+plane = "zhi"
+material = "steel"
+""")
+    out = {}
+    for on in ("1", "0"):
+        r = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", sys.executable, "-c", ON_RANKS, "run",
+                            str(case), "--test", "--out", str(tmp_path / on)], capture_output=True, text=True,
+                           env=dict(ENV, ON_RANKS=on), timeout=600)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        out[on] = json.loads((tmp_path / on / "summary.json").read_text())
+    ranks, alone = out["1"], out["0"]
+    assert ranks["collisions"] == alone["collisions"] and ranks["particle_wall"] == alone["particle_wall"] > 100
+    assert ranks["collisions_moved_on_ranks"] > 0.8 * ranks["collisions"]
+    assert ranks["heat_from_walls"] == pytest.approx(alone["heat_from_walls"], rel=1e-9) and ranks["heat_from_walls"] > 0
+    for r in (ranks, alone):
+        assert r["status"] == "completed" and abs(r["energy_balance_error"]) < 1e-12
+    a, b = (np.genfromtxt(tmp_path / on / "collisions.csv", delimiter=",", names=True, dtype=None, encoding=None)
+            for on in ("1", "0"))
+    for column in ("time", "i", "j", "wall", "v0"):
+        assert np.array_equal(a[column], b[column]), column
+    assert np.abs(a["Q"] - b["Q"]).max() <= 1e-4 * np.abs(b["Q"]).max()
+
+
 def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
     """hot-cold-box --test on two ranks with a checkpoint every 4 ms, rank 0 killed outright at
     step 6003 (mpirun ends the job) and continued with --restart on two ranks: collisions.csv,
