@@ -30,8 +30,9 @@ from pyhost.engines.events import BEGIN, END, join_moved
 from pyhost.output import ColumnLog, CsvLog, collision_kinds
 
 ON_RANKS = True
-"""Whether a harvest under MPI moves collision heat on each rank (``harvest_on_ranks``) where
-it can; False: on rank 0 alone (``harvest_partly``), which tests compare it with."""
+"""Whether a harvest under MPI between frames moves collision heat on each rank
+(``harvest_on_ranks``); False: rank 0 moves all in time order (``harvest_partly``), the
+reference tests/cases/test_mpi.py compares it with."""
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 
@@ -47,6 +48,7 @@ class CollisionHeat(Effect):
         self.restitution = scene.effects.restitution_feedback and loop.heat
         self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
         self.gathered = None                     # a harvest's log rows, while harvest_on_ranks gathers them
+        self.begun_gathered = []                 # and its collisions to give separation speeds (restitution)
         columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
         mark = (logs or {}).get("collisions")
         self.log = (ColumnLog(loop.out / "collisions", collision_kinds(columns), mark)
@@ -81,7 +83,7 @@ class CollisionHeat(Effect):
         """The contacts' work at the end of a DEM chunk: the events harvested, if due."""
         loop = self.loop
         if self.harvest_alone(due):
-            if ON_RANKS and loop.heat and not self.restitution:
+            if ON_RANKS and loop.heat:
                 self.harvest_on_ranks()
             else:
                 self.harvest_partly()
@@ -145,10 +147,10 @@ class CollisionHeat(Effect):
 
     def harvest_alone(self, due) -> bool:
         """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran:
-        then each rank moves the heat of its own collisions (``harvest_on_ranks``), or with
-        restitution feedback only the colliding atoms are gathered to rank 0
-        (``harvest_partly``). Nothing but the host changes a temperature then, and each atom's
-        heat content in the balance is brought up to date when it is next seen."""
+        then each rank moves the heat of its own collisions (``harvest_on_ranks``; with
+        ``ON_RANKS`` off, rank 0 moves all on the colliding atoms only, ``harvest_partly``).
+        Nothing but the host changes a temperature then, and each atom's heat content in the
+        balance is brought up to date when it is next seen."""
         return (self.dem.link is not None and not self.dem.events.window
                 and due["harvest"] and not any(v for k, v in due.items() if k != "harvest"))
 
@@ -164,15 +166,16 @@ class CollisionHeat(Effect):
         self.harvest(atoms, ev=ev)
 
     def harvest_on_ranks(self) -> None:
-        """A harvest under MPI with collision heat, no restitution feedback and no fix
-        heat/gran: each rank moves the heat of the collisions it can alone, on its own atoms
-        (``pyhost.effects.rank_heat``); rank 0 moves those left over on the atoms of their events
-        only (``harvest``), counts all, and writes all rows in the serial order."""
+        """A harvest under MPI with collision heat and no fix heat/gran: each rank moves the
+        heat of its own collisions, on its own atoms (``pyhost.effects.rank_heat``); rank 0 moves
+        those left over on the atoms of their events only (``harvest``), counts all, writes all
+        rows in the serial order and, with restitution feedback, gives every collision its
+        separation speed (gathering the atoms of the contacts that ended before it could)."""
         loop, balance = self.loop, self.loop.balance
         models = self.scene.effects.heat_models
         setup = RankHeat(loop.materials, loop.type_material, loop.capacity, tuple(models),
                          self.scene.effects.heat_path, self.T_wall, self.wall_material, self.dem.dt,
-                         np.packbits(balance.seen), len(balance.seen), loop.T_of_type)
+                         np.packbits(balance.seen), len(balance.seen), loop.T_of_type, self.restitution)
         parts = self.dem.each_rank(on_rank, setup)
         rows = []
         for p in parts:
@@ -191,12 +194,17 @@ class CollisionHeat(Effect):
                 self.flag_outside_range(p["flagged"], p["v_flagged"])
             rows.append((p["cols"], p["step"], p["jj"]))
         ev, self.dem.events.joined = join_moved(np.concatenate([p["events"] for p in parts]))
+        need = [ev["i"][ev["kind"] == BEGIN], ev["j"][(ev["kind"] == BEGIN) & ~ev["wall"]]]
+        if self.restitution:
+            begun = np.concatenate([p["begun"] for p in parts])
+            e = np.concatenate([p["cols"]["e"] for p in parts])
+            need += self.restitution_atoms(begun, ev[ev["kind"] == END])
+        ids = np.unique(np.concatenate(need))
         atoms = None
-        if np.any(ev["kind"] == BEGIN):
-            ids = np.unique(np.r_[ev["i"], ev["j"][~ev["wall"]]])
+        if len(ids):
             atoms = self.dem.atoms_of(ids, loop.heat)
             loop.track_particles(atoms, departures=False)
-        self.gathered = rows
+        self.gathered, self.begun_gathered = rows, []
         try:
             self.harvest(atoms, ev=ev)
         finally:
@@ -208,6 +216,24 @@ class CollisionHeat(Effect):
                                                     + sum(len(p["step"]) for p in parts))
         if len(order):
             self.record({k: v[order] for k, v in cols.items()})
+        if self.restitution:       # every collision of the batch, in the serial order
+            begun = np.concatenate([begun] + [b for b, _ in self.begun_gathered])
+            e = np.concatenate([e] + [x for _, x in self.begun_gathered])
+            order = np.lexsort((begun["j"], begun["i"], begun["wall"], begun["step"]))
+            if len(order):
+                self.ask_restitution(atoms, begun[order], e[order], ev[ev["kind"] == END])
+
+    def restitution_atoms(self, begun, ends) -> list:
+        """The ids whose atoms restitution feedback needs at this harvest: of the collisions
+        whose contact already ended (their speed is imposed now) and of the ended contacts whose
+        speed the recorder could not impose (``ask_restitution``, ``ended_with_targets``)."""
+        keys, end_keys = contact_keys(begun["i"], begun["j"]), contact_keys(ends["i"], ends["j"])
+        last_end = {}
+        for k, s in zip(end_keys.tolist(), ends["step"].tolist()):
+            last_end[k] = max(s, last_end.get(k, s))
+        late = np.array([last_end.get(k, -1) > s for k, s in zip(keys.tolist(), begun["step"].tolist())], bool)
+        missed = np.array([k in self.targets for k in end_keys.tolist()], bool) & ~ends["imposed"]
+        return [begun["i"][late], begun["j"][late & ~begun["wall"]], ends["i"][missed], ends["j"][missed & ~ends["wall"]]]
 
     def harvest(self, atoms, final: bool = False, ev=None) -> None:
         """The contact events recorded inside LIGGGHTS since the last harvest: each begun
@@ -287,7 +313,9 @@ class CollisionHeat(Effect):
                 pair = ~begin["wall"]
                 keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
                 self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), t_coll[pair].tolist()))
-            if self.restitution:
+            if self.restitution and self.gathered is not None:
+                self.begun_gathered.append((begin, e))          # asked with the ranks' (harvest_on_ranks)
+            elif self.restitution:
                 self.ask_restitution(atoms, begin, e, ends)
 
     def ask_restitution(self, atoms, begin, e, ends) -> None:

@@ -35,7 +35,7 @@ import numpy as np
 
 from plugins.heat.batch import move_heat
 from plugins.heat.exchange import WALL_BASE
-from pyhost.engines.events import BEGIN
+from pyhost.engines.events import BEGIN, END
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,8 @@ class RankHeat:
     first moves heat, the others are side columns), the plugin's path, each wall's
     temperature [K] (NaN: adiabatic) and real material (-1: the particle's), the DEM time
     step [s], which ids rank 0 has seen (``np.packbits``, ``seen_count`` of them) and the
-    temperature [K] an atom of each type starts at (NaN: its own; None: rank 0 sets them)."""
+    temperature [K] an atom of each type starts at (NaN: its own; None: rank 0 sets them);
+    with ``restitution`` (feedback), the ENDs and the collisions' events go to rank 0 too."""
 
     materials: list
     type_material: np.ndarray
@@ -59,6 +60,7 @@ class RankHeat:
     seen: np.ndarray
     seen_count: int
     T_of_type: np.ndarray | None
+    restitution: bool = False
 
 
 def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
@@ -71,8 +73,9 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     ``T_before`` and ``T_after`` [K] of this rank's atoms whose temperature changed, the atoms
     rank 0 had not seen, given their starting temperature here (``new``: ids, mass, type,
     radius and the temperature they had before), and the
-    ``events`` left to rank 0. An END is dropped unless it moved between ranks: without
-    restitution feedback and fix heat/gran nothing reads it."""
+    ``events`` left to rank 0 (with restitution feedback also every END, and the collisions'
+    events as ``begun``). Without restitution feedback an END is dropped unless it moved
+    between ranks: nothing else reads it."""
     allgather = comm.allgather if comm is not None else (lambda mine: [mine])     # (serially: one rank)
     ev = events.take()
     ids, types, T, mass, radius = atoms.id, atoms.type, atoms.T, atoms.mass, atoms.radius
@@ -119,6 +122,8 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     lj = np.where(local[j_atom] >= 0, local[j_atom], remote[j_atom])
     here = begun & ok[i] & (wall | ok[j_atom] | (remote[j_atom] >= 0))
     out = ev["moved"] | (begun & ~here)
+    if setup.restitution:              # rank 0 gives the separation speeds: it needs the ends
+        out |= ev["kind"] == END
     go = np.flatnonzero(here)
     still = go[~(ev["vn"][go] > 0)]
     go = go[ev["vn"][go] > 0]
@@ -150,6 +155,8 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
         k = local[got_id[mine]]
         np.add.at(T, k, got_q[mine] / C_all[k])       # (in the order sent: the rank, then the collision)
     changed = np.flatnonzero(T != T_before)
+    if setup.restitution:
+        result["begun"] = ev[go]
     result.update(ids=ids[changed], mass=mass[changed].copy(), type=types[changed].copy(),
                   T_before=T_before[changed], T_after=T[changed].copy(), step=ev["step"][go], jj=j[go],
                   cols=dict(time=ev["step"][go] * setup.dt, i=i[go], j=np.where(w, 0, j[go]),
