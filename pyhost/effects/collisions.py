@@ -29,6 +29,13 @@ from pyhost.engines.atoms import Atoms
 from pyhost.engines.events import BEGIN, END, join_moved
 from pyhost.output import ColumnLog, CsvLog, collision_kinds
 
+ON_RANKS_FROM = 256
+"""Collisions in the last harvest (on all ranks) from which the next is moved on each rank; a
+run whose harvests are smaller has rank 0 move them (``harvest_partly``). Each harvest on the
+ranks costs about 1 ms more on rank 0 (the plugin's fixed cost of a call on every rank, the
+merging): on hot-cold-box with restitution feedback (6 collisions per harvest, every 10
+steps) moving them on the ranks took 10-35 % more wall time on two ranks."""
+
 ON_RANKS = True
 """Whether a harvest under MPI between frames moves collision heat on each rank
 (``harvest_on_ranks``); False: rank 0 moves all in time order (``harvest_partly``), the
@@ -49,6 +56,7 @@ class CollisionHeat(Effect):
         self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
         self.gathered = None                     # a harvest's log rows, while harvest_on_ranks gathers them
         self.begun_gathered = []                 # and its collisions to give separation speeds (restitution)
+        self.last_batch = ON_RANKS_FROM          # collisions of the last harvest between frames (MPI)
         columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
         mark = (logs or {}).get("collisions")
         self.log = (ColumnLog(loop.out / "collisions", collision_kinds(columns), mark)
@@ -83,10 +91,12 @@ class CollisionHeat(Effect):
         """The contacts' work at the end of a DEM chunk: the events harvested, if due."""
         loop = self.loop
         if self.harvest_alone(due):
-            if ON_RANKS and loop.heat:
+            before = self.totals["collisions"]
+            if ON_RANKS and loop.heat and self.last_batch >= ON_RANKS_FROM:
                 self.harvest_on_ranks()
             else:
                 self.harvest_partly()
+            self.last_batch = self.totals["collisions"] - before
         elif self.wants_harvest(due):
             atoms = self.dem.atoms(loop.heat)
             loop.track_particles(atoms)
@@ -147,8 +157,9 @@ class CollisionHeat(Effect):
 
     def harvest_alone(self, due) -> bool:
         """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran:
-        then each rank moves the heat of its own collisions (``harvest_on_ranks``; with
-        ``ON_RANKS`` off, rank 0 moves all on the colliding atoms only, ``harvest_partly``).
+        then each rank moves the heat of its own collisions (``harvest_on_ranks``), or, when
+        the last such harvest was small (ON_RANKS_FROM) or ``ON_RANKS`` is off, rank 0 moves
+        all on the colliding atoms only (``harvest_partly``).
         Nothing but the host changes a temperature then, and each atom's heat content in the
         balance is brought up to date when it is next seen."""
         return (self.dem.link is not None and not self.dem.events.window
@@ -212,8 +223,9 @@ class CollisionHeat(Effect):
         step, j = (np.concatenate([r[k] for r in rows]) for k in (1, 2))
         cols = {k: np.concatenate([r[0][k] for r in rows]) for k in rows[0][0]}
         order = np.lexsort((j, cols["i"], j >= WALL_BASE, step))
-        self.totals["collisions_moved_on_ranks"] = (self.totals.get("collisions_moved_on_ranks", 0)
-                                                    + sum(len(p["step"]) for p in parts))
+        moved = sum(len(p["step"]) for p in parts)
+        if moved:
+            self.totals["collisions_moved_on_ranks"] = self.totals.get("collisions_moved_on_ranks", 0) + moved
         if len(order):
             self.record({k: v[order] for k, v in cols.items()})
         if self.restitution:       # every collision of the batch, in the serial order

@@ -112,7 +112,9 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     have = local[wanted[wanted < top]] if len(wanted) else np.zeros(0, np.int64)
     have = have[have >= 0]
     have = have[ok[ids[have]]]
-    answers = allgather((ids[have], T[have].copy(), mass[have].copy(), radius[have].copy(), material[have]))
+    # (no rank asked for any: every rank knows it from the same ``wanted``, and skips both exchanges)
+    mine = (ids[have], T[have].copy(), mass[have].copy(), radius[have].copy(), material[have])
+    answers = allgather(mine) if len(wanted) else [mine]
     r_id, r_T, r_m, r_R, r_mat = (np.concatenate([a[k] for a in answers]) for k in range(5))
     remote = np.full(max(top, int(r_id.max(initial=0)) + 1), -1, np.int64)
     remote[r_id] = len(ids) + np.arange(len(r_id))
@@ -149,7 +151,7 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     T[:] = T_all[:len(ids)]
     # the heat partners on other ranks received, to their owners, added after the owners' own
     into = (~w) & (b >= len(ids))
-    sent = allgather((j[go][into], heat["Q"][into]))
+    sent = allgather((j[go][into], heat["Q"][into])) if len(wanted) else []
     for got_id, got_q in sent:
         mine = (got_id < len(local)) & (local[np.minimum(got_id, len(local) - 1)] >= 0)
         k = local[got_id[mine]]
