@@ -37,9 +37,9 @@ merging): on hot-cold-box with restitution feedback (6 collisions per harvest, e
 steps) moving them on the ranks took 10-35 % more wall time on two ranks."""
 
 ON_RANKS = True
-"""Whether a harvest under MPI between frames moves collision heat on each rank
-(``harvest_on_ranks``); False: rank 0 moves all in time order (``harvest_partly``), the
-reference tests/cases/test_mpi.py compares it with."""
+"""Whether a harvest under MPI moves collision heat on each rank (``harvest_on_ranks``);
+False: rank 0 moves all in time order (``harvest_partly`` between frames, else on the atoms
+the frame gathers), the reference tests/cases/test_mpi.py compares it with."""
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 
@@ -88,19 +88,25 @@ class CollisionHeat(Effect):
         self.dem.event_walls(self.wall_index)
 
     def after_chunk(self, due: dict) -> None:
-        """The contacts' work at the end of a DEM chunk: the events harvested, if due."""
+        """The contacts' work at the end of a DEM chunk: the events harvested, if due. Under MPI
+        without a fix heat/gran, each rank moves its own collisions' heat (``harvest_on_ranks``)
+        unless the last harvest was small (ON_RANKS_FROM); a harvest that comes alone then
+        gathers only the colliding atoms to rank 0 (``harvest_partly``)."""
         loop = self.loop
-        if self.harvest_alone(due):
-            before = self.totals["collisions"]
-            if ON_RANKS and loop.heat and self.last_batch >= ON_RANKS_FROM:
-                self.harvest_on_ranks()
-            else:
-                self.harvest_partly()
-            self.last_batch = self.totals["collisions"] - before
-        elif self.wants_harvest(due):
+        alone = self.harvest_alone(due)
+        if not (alone or self.wants_harvest(due)):
+            return
+        before = self.totals["collisions"]
+        ranks = self.dem.link is not None and not self.dem.events.window
+        if ranks and ON_RANKS and loop.heat and self.last_batch >= ON_RANKS_FROM:
+            self.harvest_on_ranks()
+        elif alone:
+            self.harvest_partly()
+        else:
             atoms = self.dem.atoms(loop.heat)
             loop.track_particles(atoms)
             self.harvest(atoms, final=bool(due["checkpoint"]))
+        self.last_batch = self.totals["collisions"] - before
 
     def wants_harvest(self, due: dict) -> bool:
         """Whether this chunk's end needs the events taken now: a harvest, a frame or a
@@ -156,10 +162,7 @@ class CollisionHeat(Effect):
         return wall, jl, mat, np.where(wall, np.inf, atoms.radius[jj]), np.where(wall, np.inf, atoms.mass[jj])
 
     def harvest_alone(self, due) -> bool:
-        """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran:
-        then each rank moves the heat of its own collisions (``harvest_on_ranks``), or, when
-        the last such harvest was small (ON_RANKS_FROM) or ``ON_RANKS`` is off, rank 0 moves
-        all on the colliding atoms only (``harvest_partly``).
+        """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran.
         Nothing but the host changes a temperature then, and each atom's heat content in the
         balance is brought up to date when it is next seen."""
         return (self.dem.link is not None and not self.dem.events.window
