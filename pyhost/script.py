@@ -91,6 +91,8 @@ def read_script(path: str | Path, folder: str | Path | None = None, _depth: int 
                               "command by command (unroll the loop, or give the values as variables)")
         if cmd.name == "if":
             _check_if(cmd)
+        if cmd.name == "delete_atoms":
+            _check_delete(cmd)
         if cmd.name == "run":
             parse_run(cmd)              # 'run ... every' and other forms refused before any engine time
         if cmd.name == "include":
@@ -125,6 +127,22 @@ def check_types(commands: list[Command], materials: dict, where: str) -> None:
             if t > n:
                 raise ScriptError(f"{where}: materials.{name}.types: atom type {t} does not exist: "
                                   f"{box.where()} creates {n} atom type{'s' if n > 1 else ''}")
+
+
+def _check_delete(cmd: Command) -> None:
+    """``delete_atoms`` renumbers the atoms left (LIGGGHTS' default ``compress yes`` gives them
+    the ids 1..N again), and the host follows each particle by its id: its heat content in
+    the balance, the collision log, a checkpoint. A particle would take over another's id,
+    the heat that left with the deleted ones would be counted as set by the script."""
+    try:
+        words = cmd.words
+    except ValueError:
+        return                          # unbalanced quotes: LIGGGHTS says so itself
+    if "compress" in words and words.index("compress") + 1 < len(words) and words[words.index("compress") + 1] == "no":
+        return
+    raise ScriptError(f"{cmd.where()}: 'delete_atoms' renumbers the remaining atoms' ids (LIGGGHTS' default "
+                      "'compress yes'), and the host follows each particle by its id (its heat content, the "
+                      "collision log): add 'compress no' to the command")
 
 
 def _check_if(cmd: Command) -> None:

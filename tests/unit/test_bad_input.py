@@ -56,6 +56,8 @@ def test_cli_bad_input_one_line_exit_2(args, word):
     ('if "${a} > 1" then "run 200"', "'run' inside 'if': the host couples every run itself"),
     ('if "${a} > 1" then "print hi" else "shell rm x"', "'shell' inside 'if': the host does not run shell commands"),
     ("run 100 every 10 \"print x\"", "'run ... every' is not supported by the host"),
+    ("delete_atoms region out", "'delete_atoms' renumbers the remaining atoms' ids .* add 'compress no'"),
+    ("delete_atoms region out compress yes", "'delete_atoms' renumbers"),
 ])
 def test_script_commands_the_host_cannot_couple_are_refused_when_read(tmp_path, line, message):
     """Found when the script is read, before any engine time, wherever they stand (an 'if'
@@ -65,3 +67,14 @@ def test_script_commands_the_host_cannot_couple_are_refused_when_read(tmp_path, 
     (tmp_path / "in.x").write_text(f"variable a equal 2\nrun 10\n{line}\n")
     with pytest.raises(ScriptError, match=rf"in.x:3: .*{message}"):
         read_script(tmp_path / "in.x")
+
+
+def test_delete_atoms_keeping_the_ids_is_read(tmp_path):
+    """``delete_atoms ... compress no`` keeps the ids the host follows each particle by (a
+    pour on two ranks with it: the balance's terms are those of the deleted particles,
+    docs/liggghts-tutorials.md)."""
+    from pyhost.script import read_script
+
+    (tmp_path / "in.x").write_text("run 10\ndelete_atoms region out compress no\nrun 10\n")
+    assert [c.text for c in read_script(tmp_path / "in.x")] == ["run 10", "delete_atoms region out compress no",
+                                                                 "run 10"]
