@@ -123,12 +123,13 @@ class CollisionHeat(Effect):
         self.harvest(atoms)
 
     def state(self) -> tuple[dict, dict]:
-        return (dict(logs=dict(collisions=self.log.mark())),
+        return (dict(logs=dict(collisions=self.log.mark()), last_batch=self.last_batch),
                 dict(target_keys=np.array(list(self.targets), np.int64),
                      target_speed=np.array([v[0] for v in self.targets.values()]),
                      target_normal=np.array([v[1] for v in self.targets.values()]).reshape(-1, 3)))
 
     def restore(self, state: dict) -> None:
+        self.last_batch = state.get("last_batch", ON_RANKS_FROM)    # where the next harvest's heat moves (MPI)
         if self.restitution and len(state.get("target_keys", ())):   # separation speeds of contacts still open
             self.dem.events.restitution(state["target_keys"], state["target_speed"], state["target_normal"])
             self.targets = dict(zip(state["target_keys"].tolist(),
