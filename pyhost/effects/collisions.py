@@ -31,7 +31,8 @@ from pyhost.output import ColumnLog, CsvLog, collision_kinds
 
 ON_RANKS_FROM = 256
 """Collisions in the last harvest (on all ranks) from which the next is moved on each rank; a
-run whose harvests are smaller has rank 0 move them (``harvest_partly``). Each harvest on the
+run whose harvests are smaller has rank 0 move them (``harvest_partly``, or on the atoms a
+frame gathers). Each harvest on the
 ranks costs about 1 ms more on rank 0 (the plugin's fixed cost of a call on every rank, the
 merging): on hot-cold-box with restitution feedback (6 collisions per harvest, every 10
 steps) moving them on the ranks took 10-35 % more wall time on two ranks."""
@@ -56,7 +57,7 @@ class CollisionHeat(Effect):
         self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
         self.gathered = None                     # a harvest's log rows, while harvest_on_ranks gathers them
         self.begun_gathered = []                 # and its collisions to give separation speeds (restitution)
-        self.last_batch = ON_RANKS_FROM          # collisions of the last harvest between frames (MPI)
+        self.last_batch = ON_RANKS_FROM          # collisions of the last harvest (MPI: where the next moves)
         columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
         mark = (logs or {}).get("collisions")
         self.log = (ColumnLog(loop.out / "collisions", collision_kinds(columns), mark)
@@ -249,7 +250,8 @@ class CollisionHeat(Effect):
             last_end[k] = max(s, last_end.get(k, s))
         late = np.array([last_end.get(k, -1) > s for k, s in zip(keys.tolist(), begun["step"].tolist())], bool)
         missed = np.array([k in self.targets for k in end_keys.tolist()], bool) & ~ends["imposed"]
-        return [begun["i"][late], begun["j"][late & ~begun["wall"]], ends["i"][missed], ends["j"][missed & ~ends["wall"]]]
+        return [begun["i"][late], begun["j"][late & ~begun["wall"]],
+                ends["i"][missed], ends["j"][missed & ~ends["wall"]]]
 
     def harvest(self, atoms, final: bool = False, ev=None) -> None:
         """The contact events recorded inside LIGGGHTS since the last harvest: each begun

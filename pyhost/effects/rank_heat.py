@@ -2,9 +2,9 @@
 
 Under mpirun every rank records the contacts of its own atoms (``pyhost.engines.events``): a
 pair on the rank owning the smaller id, a wall contact on the particle's owner. At a harvest
-that needs nothing else (no frame, fluid exchange or checkpoint), each rank takes its events
-and moves the heat of its collisions, in their order, into LIGGGHTS' ``Temp`` of its own atoms
-(``on_rank``, run on every rank). A partner owned by another rank (a pair across the cut)
+(without a fix heat/gran; after one of at least ``ON_RANKS_FROM`` collisions), each rank takes
+its events and moves the heat of its collisions, in their order, into LIGGGHTS' ``Temp`` of its
+own atoms (``on_rank``, run on every rank). A partner owned by another rank (a pair across the cut)
 takes part with its temperature and heat capacity as its owner has them at the harvest's
 start, and the heat it received goes to its owner, which adds it to the particle's
 temperature once its own collisions are moved. Rank 0 gets the collisions' log rows, the
@@ -23,8 +23,8 @@ changes only by the walls' heat, as serially. Heat moves collision after collisi
 temperatures of that moment; a particle whose collisions of one batch are moved in two places
 (two ranks, or a rank and rank 0) sees those of the other place's after its own instead of in
 their order. The heat of such a collision differs from the serial order's by the other
-collisions' share of its temperature difference (in tests/cases/test_mpi.py: at most
-1e-9 of a collision's heat). Rank 0 writes the log rows of all in the serial order (step,
+collisions' share of its temperature difference (in tests/cases/test_mpi.py: at most 7.2e-6
+of the largest collision's heat). Rank 0 writes the log rows of all in the serial order (step,
 walls last, ids). SI units.
 """
 from __future__ import annotations
@@ -65,17 +65,20 @@ class RankHeat:
 
 def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     """One rank's part of a harvest (collective: every rank calls it): its events taken, the
-    heat of its collisions moved into its ``atoms``' T (the engine's own memory, writable), the heat of partners on other ranks
-    sent to their owners. Returns the columns of those collisions' log rows with their
-    ``step`` and partner code ``jj`` (the order rank 0 sorts by), ``still`` (contacts begun
-    without an approach speed), ``capped``, ``flagged`` (outside the models' range) and
-    ``v_flagged`` (the fastest of those), the balance's ``ids``, ``mass`` [kg], ``type``,
-    ``T_before`` and ``T_after`` [K] of this rank's atoms whose temperature changed, the atoms
-    rank 0 had not seen, given their starting temperature here (``new``: ids, mass, type,
-    radius and the temperature they had before), and the
-    ``events`` left to rank 0 (with restitution feedback also every END, and the collisions'
-    events as ``begun``). Without restitution feedback an END is dropped unless it moved
-    between ranks: nothing else reads it."""
+    heat of its collisions moved into its ``atoms``' T (the engine's own memory, writable),
+    the heat of partners on other ranks sent to their owners. Returns:
+
+    - ``cols``: those collisions' log rows, with their ``step`` and partner code ``jj`` (the
+      order rank 0 sorts by);
+    - ``still`` (contacts begun without an approach speed), ``capped``, ``flagged`` (outside
+      the models' range) and ``v_flagged`` (the fastest of those);
+    - for the balance: ``ids``, ``mass`` [kg], ``type``, ``T_before`` and ``T_after`` [K] of
+      this rank's atoms whose temperature changed, and ``new``: the atoms rank 0 had not
+      seen, given their starting temperature here (ids, mass, type, radius and the
+      temperature they had before);
+    - ``events``: those left to rank 0 (with restitution feedback also every END, and the
+      collisions' events as ``begun``). Without restitution feedback an END is dropped
+      unless it moved between ranks: nothing else reads it."""
     allgather = comm.allgather if comm is not None else (lambda mine: [mine])     # (serially: one rank)
     ev = events.take()
     ids, types, T, mass, radius = atoms.id, atoms.type, atoms.T, atoms.mass, atoms.radius
@@ -96,7 +99,6 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     wanted = np.unique(np.concatenate(allgather(asked)))
     # atoms rank 0 has not seen yet (inserted since) among those of the events and those asked
     # for: their material's temperature now, as rank 0 sets it when it first sees an atom
-    fresh = np.zeros(0, np.int64)
     if setup.T_of_type is not None:
         involved = np.zeros(top, bool)
         involved[np.r_[i[begun], j_atom[begun], wanted[wanted < top]]] = True
@@ -153,9 +155,9 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     into = (~w) & (b >= len(ids))
     sent = allgather((j[go][into], heat["Q"][into])) if len(wanted) else []
     for got_id, got_q in sent:
-        mine = (got_id < len(local)) & (local[np.minimum(got_id, len(local) - 1)] >= 0)
-        k = local[got_id[mine]]
-        np.add.at(T, k, got_q[mine] / C_all[k])       # (in the order sent: the rank, then the collision)
+        owned = (got_id < len(local)) & (local[np.minimum(got_id, len(local) - 1)] >= 0)
+        k = local[got_id[owned]]
+        np.add.at(T, k, got_q[owned] / C_all[k])       # (in the order sent: the rank, then the collision)
     changed = np.flatnonzero(T != T_before)
     if setup.restitution:
         result["begun"] = ev[go]
