@@ -32,9 +32,8 @@ from pyhost.output import ColumnLog, CsvLog, collision_kinds
 ON_RANKS_FROM = 256
 """Collisions in the last harvest (on all ranks) from which the next is moved on each rank; a
 run whose harvests are smaller has rank 0 move them (``harvest_partly``, or on the atoms a
-frame gathers). Each harvest on the
-ranks costs about 1 ms more on rank 0 (the plugin's fixed cost of a call on every rank, the
-merging): on hot-cold-box with restitution feedback (6 collisions per harvest, every 10
+frame gathers). Each harvest on the ranks costs about 1 ms more on rank 0 (the plugin's
+fixed cost of a call on every rank, the merging): on hot-cold-box with restitution feedback (6 collisions per harvest, every 10
 steps) moving them on the ranks took 10-35 % more wall time on two ranks."""
 
 ON_RANKS = True
@@ -43,6 +42,16 @@ False: rank 0 moves all in time order (``harvest_partly`` between frames, else o
 the frame gathers), the reference tests/cases/test_mpi.py compares it with."""
 
 COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
+
+
+def ended_later(begin, ends) -> np.ndarray:
+    """Whether each begun contact (BEGIN events) has an END among ``ends`` after its begin: a
+    contact shorter than the harvest interval."""
+    last = {}
+    for k, s in zip(contact_keys(ends["i"], ends["j"]).tolist(), ends["step"].tolist()):
+        last[k] = max(s, last.get(k, s))
+    return np.array([last.get(k, -1) > s for k, s in zip(contact_keys(begin["i"], begin["j"]).tolist(),
+                                                          begin["step"].tolist())], bool)
 
 
 class CollisionHeat(Effect):
@@ -55,8 +64,6 @@ class CollisionHeat(Effect):
         self.t_coll_of = {}                      # (key, begin step) -> t_coll [s] of pair collisions under heat/gran
         self.restitution = scene.effects.restitution_feedback and loop.heat
         self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
-        self.gathered = None                     # a harvest's log rows, while harvest_on_ranks gathers them
-        self.begun_gathered = []                 # and its collisions to give separation speeds (restitution)
         self.last_batch = ON_RANKS_FROM          # collisions of the last harvest (MPI: where the next moves)
         columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
         mark = (logs or {}).get("collisions")
@@ -193,7 +200,6 @@ class CollisionHeat(Effect):
                          self.scene.effects.heat_path, self.T_wall, self.wall_material, self.dem.dt,
                          np.packbits(balance.seen), len(balance.seen), loop.T_of_type, self.restitution)
         parts = self.dem.each_rank(on_rank, setup)
-        rows = []
         for p in parts:
             if len(p["new"][0]):   # inserted atoms a rank gave their starting temperature: they come in
                 balance.track(Atoms(p["new"][0], None, None, p["new"][3], p["new"][1], p["new"][2], p["new"][4]),
@@ -208,52 +214,32 @@ class CollisionHeat(Effect):
                 self.totals["contacts_without_impact"] = self.totals.get("contacts_without_impact", 0) + p["still"]
             if p["flagged"]:
                 self.flag_outside_range(p["flagged"], p["v_flagged"])
-            rows.append((p["cols"], p["step"], p["jj"]))
+        moved = [(p["cols"], p["step"], p["jj"], p.get("begun")) for p in parts]
         ev, self.dem.events.joined = join_moved(np.concatenate([p["events"] for p in parts]))
         need = [ev["i"][ev["kind"] == BEGIN], ev["j"][(ev["kind"] == BEGIN) & ~ev["wall"]]]
         if self.restitution:
-            begun = np.concatenate([p["begun"] for p in parts])
-            e = np.concatenate([p["cols"]["e"] for p in parts])
-            need += self.restitution_atoms(begun, ev[ev["kind"] == END])
+            need += self.restitution_atoms(np.concatenate([p["begun"] for p in parts]), ev[ev["kind"] == END])
         ids = np.unique(np.concatenate(need))
         atoms = None
         if len(ids):
             atoms = self.dem.atoms_of(ids, loop.heat)
             loop.track_particles(atoms, departures=False)
-        self.gathered, self.begun_gathered = rows, []
-        try:
-            self.harvest(atoms, ev=ev)
-        finally:
-            self.gathered = None
-        step, j = (np.concatenate([r[k] for r in rows]) for k in (1, 2))
-        cols = {k: np.concatenate([r[0][k] for r in rows]) for k in rows[0][0]}
-        order = np.lexsort((j, cols["i"], j >= WALL_BASE, step))
-        moved = sum(len(p["step"]) for p in parts)
-        if moved:
-            self.totals["collisions_moved_on_ranks"] = self.totals.get("collisions_moved_on_ranks", 0) + moved
-        if len(order):
-            self.record({k: v[order] for k, v in cols.items()})
-        if self.restitution:       # every collision of the batch, in the serial order
-            begun = np.concatenate([begun] + [b for b, _ in self.begun_gathered])
-            e = np.concatenate([e] + [x for _, x in self.begun_gathered])
-            order = np.lexsort((begun["j"], begun["i"], begun["wall"], begun["step"]))
-            if len(order):
-                self.ask_restitution(atoms, begun[order], e[order], ev[ev["kind"] == END])
+        count = sum(len(p["step"]) for p in parts)
+        if count:
+            self.totals["collisions_moved_on_ranks"] = self.totals.get("collisions_moved_on_ranks", 0) + count
+        self.harvest(atoms, ev=ev, moved=moved)
 
     def restitution_atoms(self, begun, ends) -> list:
         """The ids whose atoms restitution feedback needs at this harvest: of the collisions
         whose contact already ended (their speed is imposed now) and of the ended contacts whose
         speed the recorder could not impose (``ask_restitution``, ``ended_with_targets``)."""
-        keys, end_keys = contact_keys(begun["i"], begun["j"]), contact_keys(ends["i"], ends["j"])
-        last_end = {}
-        for k, s in zip(end_keys.tolist(), ends["step"].tolist()):
-            last_end[k] = max(s, last_end.get(k, s))
-        late = np.array([last_end.get(k, -1) > s for k, s in zip(keys.tolist(), begun["step"].tolist())], bool)
-        missed = np.array([k in self.targets for k in end_keys.tolist()], bool) & ~ends["imposed"]
+        late = ended_later(begun, ends)
+        targeted = [k in self.targets for k in contact_keys(ends["i"], ends["j"]).tolist()]
+        missed = np.array(targeted, bool) & ~ends["imposed"]
         return [begun["i"][late], begun["j"][late & ~begun["wall"]],
                 ends["i"][missed], ends["j"][missed & ~ends["wall"]]]
 
-    def harvest(self, atoms, final: bool = False, ev=None) -> None:
+    def harvest(self, atoms, final: bool = False, ev=None, moved=()) -> None:
         """The contact events recorded inside LIGGGHTS since the last harvest: each begun
         contact is a collision, at its impact speed as recorded at first touch, its heat moved
         now in the order the collisions happened. Without a fix heat/gran nothing else changes
@@ -268,21 +254,37 @@ class CollisionHeat(Effect):
         collision whose particle left the simulation before the harvest (deleted, out of the
         box) is counted apart (collisions_of_departed) and moves no heat: its heat content left
         when it was last seen; so is one that began with no approach speed
-        (contacts_without_impact)."""
+        (contacts_without_impact). ``moved``: batches of collisions whose heat the ranks moved
+        (``harvest_on_ranks``), concluded with this harvest's own (``conclude``)."""
         ev = self.dem.events.take() if ev is None else ev
         begin, ends = ev[ev["kind"] == BEGIN], ev[ev["kind"] == END]
         if self.dem.events.joined:               # open contacts that moved between ranks (MPI)
             self.totals["contacts_changed_rank"] = self.totals.get("contacts_changed_rank", 0) + len(self.dem.events.joined)
         if self.targets and len(ends):
             self.ended_with_targets(atoms, ends)
-        if len(begin):
-            self.collide_begun(atoms, begin, ends)
+        batches = list(moved) + (self.collide_begun(atoms, begin) if len(begin) else [])
         if self.dem.events.window:
             dt = self.dem.dt
-            for key, began, moved in self.dem.events.joined:   # a flux history goes on on another rank
+            for key, began, went in self.dem.events.joined:    # a flux history goes on on another rank
                 if (key, began) in self.t_coll_of:
-                    self.t_coll_of[key, moved] = self.t_coll_of[key, began] - (moved - began) * dt
+                    self.t_coll_of[key, went] = self.t_coll_of[key, began] - (went - began) * dt
             self.take_back_heat_gran(atoms, final)
+        self.conclude(atoms, batches, ends)
+
+    def conclude(self, atoms, batches, ends) -> None:
+        """A harvest's collisions, in batches of (log columns, steps, partners j as ids or wall
+        codes, their BEGIN events or None) whose heat is moved: counted and logged in the
+        serial order (step, walls last, ids; one batch is in it already), and with restitution
+        feedback given their separation speeds (``ask_restitution``, with the harvest's ENDs)."""
+        if not sum(len(b[1]) for b in batches):
+            return
+        step, j = (np.concatenate([b[k] for b in batches]) for k in (1, 2))
+        cols = {k: np.concatenate([b[0][k] for b in batches]) for k in batches[0][0]}
+        order = np.lexsort((j, cols["i"], j >= WALL_BASE, step))
+        cols = {k: v[order] for k, v in cols.items()}
+        self.record(cols)
+        if self.restitution:
+            self.ask_restitution(atoms, np.concatenate([b[3] for b in batches])[order], cols["e"], ends)
 
     def ended_with_targets(self, atoms, ends) -> None:
         """Contacts given a separation speed that ended since the last harvest: the recorder
@@ -307,7 +309,9 @@ class CollisionHeat(Effect):
             self.impose_separation(atoms, ends["i"][rows], ends["j"][rows], np.array([n for _, _, n in late]),
                                    np.ones(len(rows)), np.array([v for _, v, _ in late]))
 
-    def collide_begun(self, atoms, begin, ends) -> None:
+    def collide_begun(self, atoms, begin) -> list:
+        """The begun contacts of a harvest: their heat moved in order (``collide``); returns
+        them as one batch for ``conclude`` (none if no collision)."""
         i = atoms.index(begin["i"])
         j_here = np.where(begin["wall"], 0, atoms.index(np.where(begin["wall"], begin["i"], begin["j"])))
         here = (i >= 0) & (j_here >= 0)
@@ -322,19 +326,15 @@ class CollisionHeat(Effect):
         # in the order of step, then ids: not of the recorder's lists, which follow the atoms'
         # order in memory (a restart or another number of ranks changes it)
         begin = begin[np.lexsort((begin["j"], begin["i"], begin["wall"], begin["step"]))]
-        if len(begin):
-            cols = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["step"] * self.dem.dt,
-                                T_begin=begin["T"])
-            self.record(cols, begin["step"], begin["j"])
-            t_coll, e = cols["t_coll"], cols["e"]
-            if self.dem.events.window:          # each pair collision's model time, until its flux history comes
-                pair = ~begin["wall"]
-                keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
-                self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), t_coll[pair].tolist()))
-            if self.restitution and self.gathered is not None:
-                self.begun_gathered.append((begin, e))          # asked with the ranks' (harvest_on_ranks)
-            elif self.restitution:
-                self.ask_restitution(atoms, begin, e, ends)
+        if not len(begin):
+            return []
+        cols = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["step"] * self.dem.dt,
+                            T_begin=begin["T"])
+        if self.dem.events.window:              # each pair collision's model time, until its flux history comes
+            pair = ~begin["wall"]
+            keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
+            self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), cols["t_coll"][pair].tolist()))
+        return [(cols, begin["step"], begin["j"], begin)]
 
     def ask_restitution(self, atoms, begin, e, ends) -> None:
         """Restitution feedback on contact events: each collision's separation speed e v0 (e
@@ -346,11 +346,7 @@ class CollisionHeat(Effect):
         self.totals["clipped"] += int(np.sum(e > 1.0))
         speed = np.minimum(e, 1.0) * v0
         keys = contact_keys(begin["i"], begin["j"])
-        ended = {}
-        for key, step in zip(contact_keys(ends["i"], ends["j"]).tolist(), ends["step"].tolist()):
-            ended.setdefault(key, []).append(step)
-        late = np.array([any(s > b for s in ended.get(k, ())) for k, b in zip(keys.tolist(), begin["step"].tolist())],
-                        bool)
+        late = ended_later(begin, ends)
         ask = ~late & ~np.isnan(speed)
         if ask.any():
             self.dem.events.restitution(keys[ask], speed[ask], begin["n"][ask])
@@ -414,14 +410,10 @@ class CollisionHeat(Effect):
         return dict(time=time, i=ids_i, j=np.where(wall, 0, j), wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0,
                     model=np.full(len(i), models[0] if models else "none"), **heat)
 
-    def record(self, cols: dict, step=None, j=None) -> None:
-        """Collisions' columns (``collide``), in the order their heat was moved: counted in the
-        totals (heat between particles as sum |Q|, the walls' heat summed in order) and written
-        to the collision log. While ``harvest_on_ranks`` gathers the rows of a harvest (with
-        each collision's ``step`` and partner ``j``, id or wall code, to order them), kept."""
-        if self.gathered is not None:
-            self.gathered.append((cols, step, j))
-            return
+    def record(self, cols: dict) -> None:
+        """Collisions' columns (``collide``), in the serial order: counted in the totals (heat
+        between particles as sum |Q|, the walls' heat summed in order) and written to the
+        collision log."""
         wall = cols["wall"] > 0
         if self.loop.heat:
             Q = cols["Q"]
