@@ -207,14 +207,7 @@ every = 1.0
 vtk = false
 pictures = false
 """)
-    out = {}
-    for on in ("1", "0"):
-        r = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", sys.executable, "-c", ON_RANKS, "run",
-                            str(case), "--out", str(tmp_path / on)], capture_output=True, text=True,
-                           env=dict(ENV, ON_RANKS=on), timeout=600)
-        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-        out[on] = json.loads((tmp_path / on / "summary.json").read_text())
-    ranks, alone = out["1"], out["0"]
+    ranks, alone, a, b = ranks_against_rank_0(case, tmp_path)
     print({k: (ranks.get(k), alone.get(k)) for k in ("collisions", "collisions_moved_on_ranks", "heat_moved",
                                                      "energy_balance_error")})
     assert grid(tmp_path / "1") == "2 by 1 by 1"
@@ -223,8 +216,6 @@ pictures = false
     assert ranks["heat_moved"] == pytest.approx(alone["heat_moved"], rel=1e-6)
     for r in (ranks, alone):
         assert r["status"] == "completed" and abs(r["energy_balance_error"]) < 1e-12
-    a, b = (np.genfromtxt(tmp_path / on / "collisions.csv", delimiter=",", names=True, dtype=None, encoding=None)
-            for on in ("1", "0"))
     for column in ("time", "i", "j", "wall", "v0", "e", "t_coll"):
         assert np.array_equal(a[column], b[column]), column
     dQ = np.abs(a["Q"] - b["Q"]).max()
