@@ -341,16 +341,14 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
         log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
         return added
 
-    tried_to = -1                       # commands up to here were tried together (try_ahead)
     try:
         for k, cmd in enumerate(commands):
-            dem.context(cmd)
             if cmd.name != "run":
-                if k > tried_to:
-                    tried_to = next((m for m in range(k, len(commands)) if commands[m].name == "run"), len(commands))
-                    dem.try_ahead(commands[k:tried_to])
-                dem.command(cmd)
+                if k == 0 or commands[k - 1].name == "run":     # the commands up to the next run
+                    dem.commands(commands[k:next((m for m in range(k, len(commands)) if commands[m].name == "run"),
+                                                 len(commands))])
                 continue
+            dem.context(cmd)
             run = parse_run(cmd)
             if not dem.dt > 0:
                 raise ScriptError(f"{cmd.where()}: the time step is {dem.dt:g} s: give the script a positive "

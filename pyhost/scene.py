@@ -1,8 +1,10 @@
 """The scene: one declarative ``case.toml`` per case, every value given once, SI units.
 
-Loaded into the frozen dataclasses of ``pyhost.schema`` (re-exported here). A wrong key, a wrong type or an impossible value is reported
-as ``SceneError`` naming the file and the key (``case.toml: materials.glass.density: must be
-> 0, got -1``) before any engine starts. ``Scene.effects_summary()`` tells what the host will
+Read here (the file's text, its tables' shapes, every number finite, even inside lists:
+``gravity = [0, 0, nan]``), built key by key into the frozen dataclasses of ``pyhost.schema``
+(re-exported here), then checked as a whole (``pyhost.validate``). A wrong key, a wrong type
+or an impossible value is reported as ``SceneError`` naming the file and the key
+(``case.toml: materials.glass.density: must be > 0, got -1``) before any engine starts. ``Scene.effects_summary()`` tells what the host will
 build: no fluid solver for a dry scene, no contact extraction for an isothermal scene
 without restitution feedback.
 
@@ -41,6 +43,7 @@ Example::
 """
 from __future__ import annotations
 
+import math
 import re
 import tomllib
 from pathlib import Path
@@ -48,7 +51,7 @@ from pathlib import Path
 from plugins.heat import MODELS
 from pyhost.schema import (Dem, Domain, Effects, Fluid, Material, Output, Particles,  # noqa: F401
                            Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
-from pyhost.validate import check_raw, check_scene, read_text
+from pyhost.validate import check_scene
 
 
 def _box(values, key, file, n=6):
@@ -74,6 +77,57 @@ def _inlet_table(fluid, file):
 
 
 SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output", "dem")
+
+
+def read_text(path) -> str:
+    """The scene file's text; SceneError naming the file for a folder, bytes that are not
+    UTF-8, or a file that cannot be read (a missing file is left to the caller)."""
+    try:
+        raw = path.read_bytes()
+    except IsADirectoryError:
+        raise SceneError(f"{path}: is a folder; give the case folder's case.toml") from None
+    except PermissionError:
+        raise SceneError(f"{path}: cannot be read (permission denied)") from None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise SceneError(f"{path}: line {line}: not UTF-8 text (byte {raw[exc.start]:#04x})") from None
+
+
+def _finite(value, key, file) -> None:
+    if isinstance(value, float) and not math.isfinite(value):
+        raise SceneError(f"{file}: {key}: must be finite, got {value!r}")
+    if isinstance(value, list):
+        for k, v in enumerate(value):
+            _finite(v, f"{key}[{k}]", file)
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _finite(v, f"{key}.{k}", file)
+
+
+def check_raw(data: dict, file: str) -> None:
+    """Shapes the scene builder relies on, and finite numbers everywhere."""
+    for key in ("materials", "domain", "time", "effects", "fluid", "output"):
+        if key in data and not isinstance(data[key], dict):
+            raise SceneError(f"{file}: {key}: must be a table [{key}], got {data[key]!r}")
+    for name, m in data.get("materials", {}).items():
+        if not isinstance(m, dict):
+            raise SceneError(f"{file}: materials.{name}: must be a table [materials.{name}], got {m!r}")
+    for key in ("particles", "walls"):
+        items = data.get(key, [])
+        if not isinstance(items, list) or not all(isinstance(x, dict) for x in items):
+            raise SceneError(f"{file}: {key}: must be [[{key}]] tables, got {items!r}")
+    for k, p in enumerate(data.get("particles", [])):
+        positions = p.get("positions", [])
+        if not isinstance(positions, list) or not all(isinstance(x, list) for x in positions):
+            raise SceneError(f"{file}: particles[{k}].positions: must be a list of [x, y, z], "
+                             f"got {positions!r}")
+    periodic = data.get("domain", {}).get("periodic", [False] * 3)
+    if not isinstance(periodic, list) or len(periodic) != 3 or not all(isinstance(p, bool) for p in periodic):
+        raise SceneError(f"{file}: domain.periodic: must be three booleans (true/false), got {periodic!r}")
+    for key, value in data.items():
+        _finite(value, key, file)
 
 
 def read_toml(path) -> dict:

@@ -1,11 +1,8 @@
-"""Checks of a scene before any engine starts, beyond one key at a time (``pyhost.scene``):
-the file itself, the shape of its tables, and what only the whole scene tells.
+"""Checks of a whole scene before any engine starts, after ``pyhost.scene`` read the file and
+built it key by key: what only the whole scene tells.
 
-``read_text(path)``: the scene file's text, or SceneError naming the file (a folder, not
-UTF-8, unreadable). ``check_raw(data, file)``: sections of the right shape, every number
-finite, even inside lists (``gravity = [0, 0, nan]``). ``check_scene(scene)``: periodic of
-three booleans, no wall on a periodic axis, 0 < alpha_min < 1, output.every >= dem_step,
-test_end <= end, a particle count LIGGGHTS and this machine can hold, positions and regions
+``check_scene(scene)``: no wall on a periodic axis, 0 < alpha_min < 1, output.every >=
+dem_step, test_end <= end, a particle count LIGGGHTS and this machine can hold, positions and regions
 inside the box, no initial overlap between particles (periodic images considered) or with a
 wall, and a DEM step that resolves the DEM collision at the scene's highest expected speed.
 Each complaint names the file and the key, with the numbers.
@@ -25,57 +22,6 @@ BYTES_PER_PARTICLE = 2000       # LIGGGHTS' per-atom arrays, neighbour lists, th
 STEPS_PER_COLLISION = 10        # fewer DEM steps than this per DEM collision: refused
 OVERLAP_TOLERANCE = 1e-9        # relative to the sum of radii: touching is not overlapping
 AXES = "xyz"
-
-
-def read_text(path) -> str:
-    """The scene file's text; SceneError naming the file for a folder, bytes that are not
-    UTF-8, or a file that cannot be read (a missing file is left to the caller)."""
-    try:
-        raw = path.read_bytes()
-    except IsADirectoryError:
-        raise SceneError(f"{path}: is a folder; give the case folder's case.toml") from None
-    except PermissionError:
-        raise SceneError(f"{path}: cannot be read (permission denied)") from None
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise SceneError(f"{path}: line {line}: not UTF-8 text (byte {raw[exc.start]:#04x})") from None
-
-
-def _finite(value, key, file) -> None:
-    if isinstance(value, float) and not math.isfinite(value):
-        raise SceneError(f"{file}: {key}: must be finite, got {value!r}")
-    if isinstance(value, list):
-        for k, v in enumerate(value):
-            _finite(v, f"{key}[{k}]", file)
-    if isinstance(value, dict):
-        for k, v in value.items():
-            _finite(v, f"{key}.{k}", file)
-
-
-def check_raw(data: dict, file: str) -> None:
-    """Shapes the scene builder relies on, and finite numbers everywhere."""
-    for key in ("materials", "domain", "time", "effects", "fluid", "output"):
-        if key in data and not isinstance(data[key], dict):
-            raise SceneError(f"{file}: {key}: must be a table [{key}], got {data[key]!r}")
-    for name, m in data.get("materials", {}).items():
-        if not isinstance(m, dict):
-            raise SceneError(f"{file}: materials.{name}: must be a table [materials.{name}], got {m!r}")
-    for key in ("particles", "walls"):
-        items = data.get(key, [])
-        if not isinstance(items, list) or not all(isinstance(x, dict) for x in items):
-            raise SceneError(f"{file}: {key}: must be [[{key}]] tables, got {items!r}")
-    for k, p in enumerate(data.get("particles", [])):
-        positions = p.get("positions", [])
-        if not isinstance(positions, list) or not all(isinstance(x, list) for x in positions):
-            raise SceneError(f"{file}: particles[{k}].positions: must be a list of [x, y, z], "
-                             f"got {positions!r}")
-    periodic = data.get("domain", {}).get("periodic", [False] * 3)
-    if not isinstance(periodic, list) or len(periodic) != 3 or not all(isinstance(p, bool) for p in periodic):
-        raise SceneError(f"{file}: domain.periodic: must be three booleans (true/false), got {periodic!r}")
-    for key, value in data.items():
-        _finite(value, key, file)
 
 
 def max_count(memory: int | None = None) -> int:

@@ -85,11 +85,15 @@ class Dem:
         self.info.learn(cmd)
         self.report_warnings(cmd)
 
-    def try_ahead(self, cmds: list[Command]) -> None:
-        """The script's next commands tried together in one forked copy (a serial run; each
-        is otherwise tried alone): see ``Liggghts.try_ahead``."""
+    def commands(self, cmds: list[Command]) -> None:
+        """The script's commands up to its next ``run`` (none of them a run), in order. A serial
+        run tries them together first in one forked copy (each is otherwise tried alone: see
+        ``Liggghts.try_ahead``); a refusal names the script's file and line."""
         if self.link is None:
             self.lmp.try_ahead([c.text for c in cmds])
+        for cmd in cmds:
+            self.context(cmd)
+            self.command(cmd)
 
     def context(self, cmd: Command) -> None:
         """The script command under way, on every rank: named if LIGGGHTS ends the process

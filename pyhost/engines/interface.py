@@ -38,9 +38,10 @@ class DemEngine(Protocol):
     def command(self, cmd) -> None:
         """Run one script command (not a ``run``)."""
 
-    def try_ahead(self, cmds) -> None:
-        """The next script commands (up to the next ``run``), which will come in this order:
-        an engine that checks each command before running it may check them together now."""
+    def commands(self, cmds) -> None:
+        """Run the script's commands up to its next ``run`` (none of them a run), in order,
+        each named in the engine's errors (an engine that checks each command before running
+        it may check them together first)."""
 
     def engine_command(self, line: str) -> None:
         """Run a command of the host's own (write_restart, ...)."""
