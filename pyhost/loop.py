@@ -50,6 +50,12 @@ FRAME_EVERY = 1e-3
 """s between frames where output.every is 0 and the script has no dump (box scenes: always)."""
 
 
+def totals() -> dict:
+    """The run's totals at its start (summary.json): the ``TOTALS`` of every effect that adds
+    to them, present in the scene or not (a summary has the same keys whatever the scene)."""
+    return {key: value for effect in (CollisionHeat, EnergyBalance, FluidExchange) for key, value in effect.TOTALS.items()}
+
+
 @dataclass(frozen=True)
 class HostWall:
     """A LIGGGHTS wall as the host sees it: its fix id (and the index of the mesh within a
@@ -91,11 +97,7 @@ class Coupling:
         self.t0_step = dem.step
         self.t = dem.step * dem.dt
         self.steps = 0
-        self.totals = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0,
-                           heat_from_walls=0.0, capped=0, clipped=0, heat_gran_undone=0.0,
-                           inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0,
-                           energy_mass_change=0.0, outside_model_range=0,
-                           heat_convected=0.0, heat_convected_gross=0.0)
+        self.totals = totals()            # summary.json's, every effect's whether the scene has it or not
         self.warned = set()
         self.heat = self.effects["particle_temperatures"]
         logs = resume["logs"] if resume else {}
@@ -265,9 +267,8 @@ class Coupling:
         """Continue from ``state`` (values and arrays of :meth:`state` in one dict)."""
         for name in ("t0_step", "steps", "t"):
             setattr(self, name, state[name])
-        self.totals, self.warned = state["totals"], set(state["warned"])
-        self.totals.setdefault("energy_mass_change", 0.0)
-        self.totals.setdefault("outside_model_range", 0)
+        self.totals = dict(totals(), **state["totals"])    # (a total newer than the checkpoint starts at 0)
+        self.warned = set(state["warned"])
         checkpoint.restore_forces(self.dem, state)
         self.dem.set_mesh_motion_times(state.get("mesh_motion", {}))
         self.dem.set_random_states(state.get("randoms", {}))

@@ -33,8 +33,25 @@ class Done(Exception):
     """The loop's first advance: the set-up is over."""
 
 
-def trace(tree: Path, case: Path) -> list[str]:
-    """The sequence of project files the set-up of a run of ``case`` passes through."""
+STAGES = (("scene", "pyhost/scene.py", "load_scene"), ("world", "pyhost/world.py", "simulate"),
+          ("script", "pyhost/loop.py", "run_scene"), ("effects", "pyhost/loop.py", "__init__"),
+          ("effects", "pyhost/loop.py", "start"))
+"""The set-up's stages, each from a call of its function (innermost wins); the command's own
+calls (output folder, pictures) are 'command'."""
+
+
+def stage_of(frame, tree: Path) -> str:
+    while frame is not None:
+        for name, file, function in STAGES:
+            if frame.f_code.co_name == function and frame.f_code.co_filename == str(tree / file):
+                return name
+        frame = frame.f_back
+    return "command"
+
+
+def trace(tree: Path, case: Path) -> list[tuple[str, str]]:
+    """The sequence of project files the set-up of a run of ``case`` passes through, each with
+    the stage it is in."""
     sys.path.insert(0, str(tree))
     from pyhost.cli import main
 
@@ -70,9 +87,10 @@ def trace(tree: Path, case: Path) -> list[str]:
                 skipping.append(frame)
                 return
             read.add(code)
-        here = project(frame if event == "call" else frame.f_back)
-        if here is not None and (not seq or seq[-1] != here):
-            seq.append(here)
+        at = frame if event == "call" else frame.f_back
+        here = project(at)
+        if here is not None and (not seq or seq[-1][0] != here):
+            seq.append((here, stage_of(at, tree)))
 
     with tempfile.TemporaryDirectory() as out:
         sys.setprofile(profile)
@@ -82,18 +100,20 @@ def trace(tree: Path, case: Path) -> list[str]:
             pass
         finally:
             sys.setprofile(None)
-    return [str(Path(f).relative_to(tree)) for f in seq]
+    return [(str(Path(f).relative_to(tree)), stage) for f, stage in seq]
 
 
-def measure(seq: list[str]) -> dict:
-    entries = Counter(seq)
-    seen, returns = set(), 0
-    for k, f in enumerate(seq):
-        if f in seen:
-            returns += 1
+def measure(seq: list[tuple[str, str]]) -> dict:
+    """Stops, files, the file entered most, returns; and (stops, returns) by stage."""
+    entries = Counter(f for f, _ in seq)
+    seen, returns, stages = set(), 0, {}
+    for f, stage in seq:
+        stops, back = stages.get(stage, (0, 0))
+        stages[stage] = (stops + 1, back + (f in seen))
+        returns += f in seen
         seen.add(f)
     worst = entries.most_common(1)[0] if entries else ("", 0)
-    return dict(stops=len(seq), files=len(entries), most_entries=worst, returns=returns)
+    return dict(stops=len(seq), files=len(entries), most_entries=worst, returns=returns, stages=stages)
 
 
 def main(argv=None) -> int:
@@ -105,9 +125,10 @@ def main(argv=None) -> int:
     seq = trace(args.tree.resolve(), args.case.resolve())
     m = measure(seq)
     if args.list:
-        print("\n".join(seq))
+        print("\n".join(f"{stage:8s} {f}" for f, stage in seq))
     print(f"{args.tree}: {m['stops']} stops in {m['files']} files, {m['returns']} returns to a file already left; "
           f"most entries: {m['most_entries'][1]} into {m['most_entries'][0]}")
+    print("by stage (stops, returns): " + ", ".join(f"{name} {s}, {r}" for name, (s, r) in m["stages"].items()))
     return 0
 
 

@@ -3,10 +3,11 @@
 ``pyhost.loop.Coupling`` runs the DEM in chunks and hands the particles to a list of effects,
 built from what the scene asks for (``Scene.effects_summary``): no fluid exchange for a dry
 scene, no collision heat for an isothermal one. An effect owns its history.csv columns
-(``columns`` and ``row``), its part of a checkpoint (``state`` and ``restore``) and its files;
-the run's totals (summary.json) are one dict of the loop's that the effects add to. A new
-output column is one line of one effect's ``columns`` and ``row``; a new effect is one module
-here and one line in ``Coupling``.
+(``columns`` and ``row``), the run's totals it adds to (``TOTALS``, their starting values; the
+loop keeps every effect's in one dict, ``loop.totals``, written to summary.json), its part of
+a checkpoint (``state`` and ``restore``) and its files. A new output column is one line of one
+effect's ``columns`` and ``row``, a new total one entry of its ``TOTALS``; a new effect is one
+module here and one line in ``Coupling`` (two if it has totals: ``pyhost.loop.totals``).
 
 Hooks, called by the loop on every effect in the list's order (the defaults do nothing):
 
@@ -30,6 +31,7 @@ class Effect:
     """One thing the loop does; ``loop`` is the ``pyhost.loop.Coupling`` that runs it."""
 
     columns: tuple = ()
+    TOTALS: dict = {}                 # the summary's totals it adds to, with their values at the start
     failure: str | None = None        # what its finish found broken (a completed run only)
 
     def __init__(self, loop):

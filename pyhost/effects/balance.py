@@ -25,6 +25,9 @@ class EnergyBalance(Effect):
     """Each particle's heat content m c T [J], mass [kg] and entry temperature [K] by id, as
     when last seen; ``C``: m c [J/K] of the atoms last seen, in their order."""
 
+    TOTALS = dict(inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0,
+                  energy_mass_change=0.0)
+
     def __init__(self, loop):
         super().__init__(loop)
         self.CT_by_id = np.zeros(0)       # m c T of each id when last seen [J] (energy balance)

@@ -58,6 +58,9 @@ class CollisionHeat(Effect):
     """``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
     ``logs``: the checkpoint's output marks to continue from (None: a new run)."""
 
+    TOTALS = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0, heat_from_walls=0.0,
+                  capped=0, clipped=0, heat_gran_undone=0.0, outside_model_range=0)
+
     def __init__(self, loop, walls, logs: dict | None = None):
         super().__init__(loop)
         scene = loop.scene

@@ -50,6 +50,8 @@ class FluidExchange(Effect):
     """``fluid``: the running solver (pyhost.engines.openfoam.FluidSolver); ``logs``: the
     checkpoint's output marks to continue from (None: a new run)."""
 
+    TOTALS = dict(heat_convected=0.0, heat_convected_gross=0.0)
+
     def __init__(self, loop, fluid, logs: dict | None = None):
         super().__init__(loop)
         self.fluid = fluid
