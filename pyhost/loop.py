@@ -346,8 +346,8 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
         for k, cmd in enumerate(commands):
             if cmd.name != "run":
                 if k == 0 or commands[k - 1].name == "run":     # the commands up to the next run
-                    dem.commands(commands[k:next((m for m in range(k, len(commands)) if commands[m].name == "run"),
-                                                 len(commands))])
+                    upto = next((m for m in range(k, len(commands)) if commands[m].name == "run"), len(commands))
+                    dem.commands(commands[k:upto])
                 continue
             dem.context(cmd)
             run = parse_run(cmd)

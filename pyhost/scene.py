@@ -4,9 +4,9 @@ Read here (the file's text, its tables' shapes, every number finite, even inside
 ``gravity = [0, 0, nan]``), built key by key into the frozen dataclasses of ``pyhost.schema``
 (re-exported here), then checked as a whole (``pyhost.validate``). A wrong key, a wrong type
 or an impossible value is reported as ``SceneError`` naming the file and the key
-(``case.toml: materials.glass.density: must be > 0, got -1``) before any engine starts. ``Scene.effects_summary()`` tells what the host will
-build: no fluid solver for a dry scene, no contact extraction for an isothermal scene
-without restitution feedback.
+(``case.toml: materials.glass.density: must be > 0, got -1``) before any engine starts.
+``Scene.effects_summary()`` tells what the host will build: no fluid solver for a dry scene,
+no contact extraction for an isothermal scene without restitution feedback.
 
 Example::
 

@@ -2,9 +2,10 @@
 built it key by key: what only the whole scene tells.
 
 ``check_scene(scene)``: no wall on a periodic axis, 0 < alpha_min < 1, output.every >=
-dem_step, test_end <= end, a particle count LIGGGHTS and this machine can hold, positions and regions
-inside the box, no initial overlap between particles (periodic images considered) or with a
-wall, and a DEM step that resolves the DEM collision at the scene's highest expected speed.
+dem_step, test_end <= end, a particle count LIGGGHTS and this machine can hold, positions
+and regions inside the box, no initial overlap between particles (periodic images
+considered) or with a wall, and a DEM step that resolves the DEM collision at the scene's
+highest expected speed.
 Each complaint names the file and the key, with the numbers.
 """
 from __future__ import annotations

@@ -9,8 +9,9 @@ Read as a reader follows the calls: each function once, at its first call (a fun
 again is not entered again, nor what it calls). Only the project's own files count (pyhost/,
 plugins/), module-level code (imports) not. The current file is that of the innermost project
 frame; each change of it is a stop. Printed: the stops, the files, the most entries into one
-file, and the returns (entries into a file already left before). Run it on another checkout to
-compare:
+file, and the returns (entries into a file already left before); then the stops and returns of
+each stage of the set-up (``STAGES``: the scene, the world, the script, the effects; the
+command's own calls). Run it on another checkout to compare:
 
     .venv/bin/python tools/trace_files.py [--case cases/two-particles] [--tree PATH] [--list]
 
