@@ -131,3 +131,26 @@ def test_the_plugins_python_is_pure_but_for_the_table_cache():
         if names & io_modules or opens:
             found[name] = sorted(names & io_modules) + (["open()"] if opens else [])
     assert found == {}
+
+
+def test_each_total_is_declared_once_by_the_effect_that_adds_to_it():
+    """summary.json's totals: each effect's ``TOTALS`` (no key in two effects: they would add
+    to one number without knowing), all of them in ``pyhost.loop.totals()``, and every total an
+    effect adds to with ``+=`` declared (else the run's first such addition is a KeyError)."""
+    from pyhost.effects.balance import EnergyBalance
+    from pyhost.effects.collisions import CollisionHeat
+    from pyhost.effects.fluid import FluidExchange
+    from pyhost.loop import totals
+
+    declared = [k for effect in (CollisionHeat, EnergyBalance, FluidExchange) for k in effect.TOTALS]
+    assert len(declared) == len(set(declared)), sorted(k for k in declared if declared.count(k) > 1)
+    assert list(totals()) == declared and not any(totals().values())
+    added = set()
+    for f in (ROOT / "pyhost" / "effects").glob("*.py"):
+        for node in ast.walk(ast.parse(f.read_text())):
+            if (isinstance(node, ast.AugAssign) and isinstance(node.target, ast.Subscript)
+                    and isinstance(node.target.slice, ast.Constant) and isinstance(node.target.slice.value, str)
+                    and ast.unparse(node.target.value) in ("t", "totals", "self.totals", "loop.totals", "self.loop.totals")):
+                added.add((f.name, node.target.slice.value))
+    assert len(added) >= 15                     # (the scan finds the effects' additions)
+    assert not {k for _, k in added} - set(declared), sorted(added)
