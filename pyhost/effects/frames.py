@@ -39,9 +39,9 @@ class Frames(Effect):
         heat = loop.heat
         atoms = loop.dem.atoms(heat)
         T = atoms.T if heat else np.full(len(atoms.id), np.nan)
-        if heat:
-            loop.track_particles(atoms)
-        C = loop.C if heat else np.ones(len(atoms.id))
+        if heat:                        # (the balance brought up to date: its C is these atoms')
+            loop.balance.track(atoms)
+        C = loop.balance.C if heat else np.ones(len(atoms.id))
         group = self.group_of(atoms)
         means = tuple(float(np.sum(C[group == k] * T[group == k]) / max(np.sum(C[group == k]), 1e-300))
                       if np.any(group == k) else math.nan for k in range(len(self.group_names)))
