@@ -138,7 +138,8 @@ def _check_delete(cmd: Command) -> None:
         words = cmd.words
     except ValueError:
         return                          # unbalanced quotes: LIGGGHTS says so itself
-    if "compress" in words and words.index("compress") + 1 < len(words) and words[words.index("compress") + 1] == "no":
+    k = words.index("compress") + 1 if "compress" in words else len(words)
+    if words[k:k + 1] == ["no"]:
         return
     raise ScriptError(f"{cmd.where()}: 'delete_atoms' renumbers the remaining atoms' ids (LIGGGHTS' default "
                       "'compress yes'), and the host follows each particle by its id (its heat content, the "

@@ -150,6 +150,7 @@ def user_script(scene):
     for k, m in enumerate(scene.materials.values()):
         type_material[m.types] = k
     T_material = np.array([m.temperature if m.temperature > 0 else np.nan for m in scene.materials.values()])
+    T_of_type = np.where(type_material >= 0, T_material[type_material], np.nan)
 
     told = set()
 
@@ -170,8 +171,8 @@ def user_script(scene):
 
     return dict(type_material=type_material,
                 groups=(names, lambda atoms: type_material[np.minimum(atoms.type, top)]),
-                initial_T=lambda atoms, new: T_material[type_material[np.minimum(atoms.type[new], top)]],
-                T_of_type=np.where(type_material >= 0, T_material[type_material], np.nan), walls_of=walls_of)
+                initial_T=lambda atoms, new: T_of_type[np.minimum(atoms.type[new], top)],
+                T_of_type=T_of_type, walls_of=walls_of)
 
 
 def driven_time(scene) -> float:

@@ -33,8 +33,9 @@ ON_RANKS_FROM = 256
 """Collisions in the last harvest (on all ranks) from which the next is moved on each rank; a
 run whose harvests are smaller has rank 0 move them (``harvest_partly``, or on the atoms a
 frame gathers). Each harvest on the ranks costs about 1 ms more on rank 0 (the plugin's
-fixed cost of a call on every rank, the merging): on hot-cold-box with restitution feedback (6 collisions per harvest, every 10
-steps) moving them on the ranks took 10-35 % more wall time on two ranks."""
+fixed cost of a call on every rank, the merging): on hot-cold-box with restitution feedback
+(6 collisions per harvest, every 10 steps) moving them on the ranks took 10-35 % more wall
+time on two ranks."""
 
 ON_RANKS = True
 """Whether a harvest under MPI moves collision heat on each rank (``harvest_on_ranks``);

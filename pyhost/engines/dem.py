@@ -266,12 +266,11 @@ class Dem:
         """Every rank keeps a copy of its atoms' ids, positions [m] and velocities [m/s] (what a
         report of lost particles says of them: ``snapshot``); returns the number of particles.
         Under MPI nothing but the counts goes to rank 0."""
-        if self.link is None:
-            self._snapshot = local_snapshot(self.lmp)
-            return len(self._snapshot[0])
-        self._order("keep_snapshot")
+        if self.link is not None:
+            self._order("keep_snapshot")
         self._snapshot = local_snapshot(self.lmp)
-        return int(sum(self.link.gather(len(self._snapshot[0]))))
+        n = len(self._snapshot[0])
+        return n if self.link is None else int(sum(self.link.gather(n)))
 
     @collective
     def snapshot(self) -> tuple:
