@@ -68,30 +68,44 @@ class HostWall:
     mesh: int = 0
 
 
+@dataclass(frozen=True)
+class Known:
+    """What the host knows of each particle before LIGGGHTS holds it, by atom id (a box scene:
+    the host placed every particle) or by atom type (a user's script: by its material): the
+    group of the history's T_group columns (index into ``names``; -1: none) and the
+    starting temperature [K] (NaN: keep the value LIGGGHTS holds). Tables are indexed by the
+    key; a key beyond a table takes its last entry."""
+
+    by: str                 # "id" or "type"
+    group: np.ndarray
+    T: np.ndarray
+    names: tuple
+
+    def of(self, table: np.ndarray, atoms, mask=slice(None)) -> np.ndarray:
+        """``table``'s entry (``group`` or ``T``) for each atom (of ``mask``)."""
+        return table[np.minimum(getattr(atoms, self.by)[mask], len(table) - 1)]
+
+
 class Coupling:
     """The coupled run of a scene on a prepared ``Dem``; ``advance(n)`` runs n DEM steps,
     ``finish()`` writes and returns the summary.
 
     ``type_material``: material index of each atom type (index = type; -1: none);
-    ``groups``: (names, function atoms -> group index per atom) for the history columns;
-    ``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
-    ``initial_T``: function (atoms, mask of new atoms) -> their starting temperature [K]
-    (NaN: keep the value LIGGGHTS holds); ``T_of_type``: the same by atom type, where it depends on
-    the type alone (else None). The contacts present at the start (overlaps as
-    placed, a script's read_restart of a settled bed) are not collisions: open and enduring.
+    ``known``: each particle's group and starting temperature (``Known``);
+    ``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes.
+    The contacts present at the start (overlaps as placed, a script's read_restart of a
+    settled bed) are not collisions: open and enduring.
     ``resume``: a checkpoint's state (pyhost.checkpoint) to continue from, its logs appended to.
     """
 
-    def __init__(self, scene, dem: Dem, out: Path, *, type_material, groups, walls, initial_T, fluid=None,
-                 end: float | None = None, progress_every: float = 5.0, keep_all: np.ndarray | None = None,
-                 T_of_type: np.ndarray | None = None, resume: dict | None = None):
+    def __init__(self, scene, dem: Dem, out: Path, *, type_material, known: Known, walls, fluid=None,
+                 end: float | None = None, progress_every: float = 5.0, resume: dict | None = None):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
         self.materials = script_dem_contacts(scene, dem) if scene.scripted else list(scene.materials.values())
         self.type_material = np.asarray(type_material, int)
-        self.initial_T = initial_T
-        self.T_of_type = T_of_type       # initial_T by type alone, where it is (a script's scene) [K]
-        self.keep_all = keep_all         # box scenes: group of each id; losing any particle is a failure
+        self.known = known
+        self.keep_all = known.group if known.by == "id" else None   # box scenes: losing any particle fails
         self.before = None               # box scenes: (time, step, particles) before the chunk under way
         self.capacity = np.array([m.heat_capacity for m in self.materials])
         self.t0_step = dem.step
@@ -108,7 +122,7 @@ class Coupling:
         if resume is None and self.balance is not None:
             self.balance.begin(dem.atoms(True))
         self.fluid_exchange = FluidExchange(self, fluid, logs) if fluid is not None else None
-        self.frames = Frames(self, groups, [self.fluid_exchange] if fluid is not None else [], logs)
+        self.frames = Frames(self, [self.fluid_exchange] if fluid is not None else [], logs)
         self.effect_list = [e for e in (self.balance, self.collisions, self.fluid_exchange, self.frames) if e is not None]
         self.progress = Progress(end or math.inf, progress_every)
         events = self.collisions is not None
@@ -313,8 +327,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     ``max_time`` [s] of coupled time, for smoke runs, are cut). ``driven`` [s]: how long the
     script's last ``run`` lasts when it asks for 0 steps (a CFD-DEM script whose coupling
     drives the run, as CFDEM's end in ``run 0``). ``walls_of(dem)`` gives the HostWalls once
-    the script's walls exist; ``particles``: type_material, groups and initial_T of
-    ``Coupling``. Returns the summary, also written when a step fails; a script whose runs
+    the script's walls exist; ``particles``: type_material, known and resume of ``Coupling``. Returns the summary, also written when a step fails; a script whose runs
     simulate no step at all is refused (ScriptError) rather than ending as done."""
     coupling = None
     effects = scene.effects_summary()

@@ -106,7 +106,7 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
     then are not collisions of this run. ``restart``: LIGGGHTS' restart file of a checkpoint
     to read instead of the particles (the same commands re-issued, with the same ids)."""
     from pyhost.dem_input import input_lines, place_particles, write_data
-    from pyhost.loop import HostWall
+    from pyhost.loop import HostWall, Known
 
     folder = out / "dem"
     folder.mkdir(parents=True, exist_ok=True)
@@ -121,22 +121,18 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
                  for line in input_lines(scene, Path("-"))]
     script.write_text("\n".join(["atom_modify sort 0 0"] + lines + [run]) + "\n")
     index = {name: k for k, name in enumerate(scene.materials)}
-    T_by_id = np.r_[np.nan, particles.temperature]
-    group_by_id = np.r_[-1, particles.group]
-    names = [f"{g.material} {g.temperature:g} K" for g in scene.particles]
+    known = Known("id", np.r_[-1, particles.group], np.r_[np.nan, particles.temperature],
+                  tuple(f"{g.material} {g.temperature:g} K" for g in scene.particles))
     walls = [HostWall(f"wall{k}", index[w.material], w.temperature if w.temperature > 0 else np.nan)
              for k, w in enumerate(scene.walls)]
-    return script, dict(type_material=[-1] + list(range(len(index))),
-                        groups=(names, lambda atoms: group_by_id[atoms.id]),
-                        initial_T=lambda atoms, new: T_by_id[atoms.id[new]],
-                        walls_of=lambda dem: walls, keep_all=group_by_id)
+    return script, dict(type_material=[-1] + list(range(len(index))), known=known, walls_of=lambda dem: walls)
 
 
 def user_script(scene):
     """How the host sees the particles of a user's script: each atom type's material from
     [materials.NAME] types, groups = materials, walls = the scene's [[walls]] (by fix id) and
     every other wall/gran fix of the script as an adiabatic wall."""
-    from pyhost.loop import HostWall
+    from pyhost.loop import HostWall, Known
     from pyhost.scene import SceneError
 
     names = list(scene.materials)
@@ -169,10 +165,8 @@ def user_script(scene):
         return [HostWall(f, *named.get(f, (-1, np.nan)), mesh=k)
                 for f, wall in known.items() for k in range(max(len(wall.meshes), 1))]
 
-    return dict(type_material=type_material,
-                groups=(names, lambda atoms: type_material[np.minimum(atoms.type, top)]),
-                initial_T=lambda atoms, new: T_of_type[np.minimum(atoms.type[new], top)],
-                T_of_type=T_of_type, walls_of=walls_of)
+    return dict(type_material=type_material, known=Known("type", type_material, T_of_type, tuple(names)),
+                walls_of=walls_of)
 
 
 def driven_time(scene) -> float:

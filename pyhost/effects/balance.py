@@ -75,7 +75,7 @@ class EnergyBalance(Effect):
                 first = by_id(came, T_came, ids[new], missing=np.nan)
                 T_entry = np.where(np.isnan(first), T_entry, first)
         if new.any():
-            T_set = loop.initial_T(atoms, new)
+            T_set = loop.known.of(loop.known.T, atoms, new)
             atoms.T[new] += np.where(np.isnan(T_set), 0.0, T_set - T_entry)    # what it was conducted kept
             T_entry = np.where(np.isnan(T_set), T_entry, T_set)
             cold = new & ~(atoms.T > 0)

@@ -202,7 +202,8 @@ class CollisionHeat(Effect):
         models = self.scene.effects.heat_models
         setup = RankHeat(loop.materials, loop.type_material, loop.capacity, tuple(models),
                          self.scene.effects.heat_path, self.T_wall, self.wall_material, self.dem.dt,
-                         np.packbits(balance.seen), len(balance.seen), loop.T_of_type, self.restitution)
+                         np.packbits(balance.seen), len(balance.seen),
+                         loop.known.T if loop.known.by == "type" else None, self.restitution)
         parts = self.dem.each_rank(on_rank, setup)
         for p in parts:
             if len(p["new"][0]):   # inserted atoms a rank gave their starting temperature: they come in

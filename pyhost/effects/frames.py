@@ -17,14 +17,13 @@ TOTAL_COLUMNS = ("heat_from_walls", "energy_in", "energy_out", "collisions", "ca
 
 
 class Frames(Effect):
-    """``groups``: (names, function atoms -> group index per atom) for the T_group columns;
-    ``others``: the effects whose columns follow, in order; ``logs``: the checkpoint's output
+    """The T_group columns: the loop's ``known`` groups; ``others``: the effects whose columns follow, in order; ``logs``: the checkpoint's output
     marks to continue from (None: a new run)."""
 
-    def __init__(self, loop, groups, others, logs: dict | None = None):
+    def __init__(self, loop, others, logs: dict | None = None):
         super().__init__(loop)
         logs = logs or {}
-        self.group_names, self.group_of = groups
+        self.group_names = list(loop.known.names)
         self.others = others
         self.columns = (("time", "particles", "T_mean", "T_min", "T_max")
                         + tuple(f"T_group{k}" for k in range(len(self.group_names))) + ("sum_mcT",) + TOTAL_COLUMNS
@@ -42,7 +41,7 @@ class Frames(Effect):
         if heat:                        # (the balance brought up to date: its C is these atoms')
             loop.balance.track(atoms)
         C = loop.balance.C if heat else np.ones(len(atoms.id))
-        group = self.group_of(atoms)
+        group = loop.known.of(loop.known.group, atoms)
         means = tuple(float(np.sum(C[group == k] * T[group == k]) / max(np.sum(C[group == k]), 1e-300))
                       if np.any(group == k) else math.nan for k in range(len(self.group_names)))
         stats = (float(T.mean()), float(T.min()), float(T.max())) if len(T) else (math.nan,) * 3
