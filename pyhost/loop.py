@@ -327,8 +327,9 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     ``max_time`` [s] of coupled time, for smoke runs, are cut). ``driven`` [s]: how long the
     script's last ``run`` lasts when it asks for 0 steps (a CFD-DEM script whose coupling
     drives the run, as CFDEM's end in ``run 0``). ``walls_of(dem)`` gives the HostWalls once
-    the script's walls exist; ``particles``: type_material, known and resume of ``Coupling``. Returns the summary, also written when a step fails; a script whose runs
-    simulate no step at all is refused (ScriptError) rather than ending as done."""
+    the script's walls exist; ``particles``: type_material, known and resume of ``Coupling``.
+    Returns the summary, also written when a step fails; a script whose runs simulate no step
+    at all is refused (ScriptError) rather than ending as done."""
     coupling = None
     effects = scene.effects_summary()
     resume = particles.get("resume")
