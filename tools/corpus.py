@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Run public tutorials nobody here wrote through the host, as a user would, and check
 their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI and packedBedTemp, and
-Debian's liggghts-doc tutorials (packing, heatTransfer_1, chute_wear, conveyor).
+Debian's liggghts-doc tutorials (packing, heatTransfer_1 and _2, chute_wear, conveyor,
+meshGran, movingMeshGran, insert_stream, mesh_tet, hysteresis, cohesion, contactModels).
 
 The tutorials are not part of this repository (their licences are theirs, and fetched
 content is never committed): point ``--cfdem`` at a CFDEMcoupling-PUBLIC checkout; Debian's
@@ -62,7 +63,8 @@ class Check:
         return math.isfinite(self.value) and abs(self.value - self.reference) <= self.tol * scale
 
     def __str__(self) -> str:
-        tol = f"{self.tol:.0%}" if self.relative else f"+-{self.tol:g}"
+        tol = (f"+-{self.tol:g}" if not self.relative else f"{self.tol:.0%}" if self.tol >= 0.01
+               else f"{self.tol:g} relative")
         return f"{self.name}: {self.value:.6g} ({self.reference:.6g}, {tol}) {'ok' if self.ok else 'FAILED'}"
 
 
@@ -192,6 +194,18 @@ def liggghts_checks(w: Path, out: Path) -> list[Check]:
     return [balance_check(out)]
 
 
+def sources_checks(w: Path, out: Path) -> list[Check]:
+    """heatTransfer_2: the heat its heat/gran sources put in (heat_from_sources) against
+    LIGGGHTS' own count of the atoms each ``set`` gave +1.5 W and -1.5 W ('N settings made', in
+    that order), over the steps since step 20000, where the script sets them."""
+    made = [int(line.split()[0]) for line in (out / "dem" / "log.liggghts").read_text().splitlines()
+            if "settings made for property/atom" in line]
+    s = summary(out)
+    expected = (made[0] - made[1]) * 1.5 * (s["steps"] - 20000) * 2.5e-5 if len(made) == 2 else math.nan
+    return [balance_check(out), Check("heat from the script's sources [J]", s.get("heat_from_sources", math.nan),
+                                      expected, 1e-9)]
+
+
 MATERIAL = """
 [materials.beads]                   # real values for the contact models (not in the tutorial)
 types = [1]
@@ -243,13 +257,24 @@ TUTORIALS = [
                       drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
                       drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks")],
              native_first=("DEM", "in.liggghts_init"), checks=packed_bed_checks),
-    Tutorial("packing", "liggghts", "packing", ".", liggghts_scene("in.packing", 2500.0), checks=liggghts_checks),
     Tutorial("heatTransfer_1", "liggghts", "heatTransfer_1", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),
              checks=liggghts_checks),
-    Tutorial("chute_wear", "liggghts", "chute_wear", ".", liggghts_scene("in.chute_wear", 2500.0),
-             checks=liggghts_checks),
-    Tutorial("conveyor", "liggghts", "conveyor", ".", liggghts_scene("in.conveyor", 2500.0), checks=liggghts_checks),
-]
+    Tutorial("heatTransfer_2", "liggghts", "heatTransfer_2", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),
+             checks=sources_checks),
+] + [Tutorial(name, "liggghts", folder, ".", liggghts_scene(script, density), checks=liggghts_checks)
+     for name, folder, script, density in (          # Debian's, run as they are; density = the script's
+         ("packing", "packing", "in.packing", 2500.0),
+         ("chute_wear", "chute_wear", "in.chute_wear", 2500.0),
+         ("conveyor", "conveyor", "in.conveyor", 2500.0),
+         ("meshGran", "meshGran", "in.meshGran", 2500.0),
+         ("movingMeshGran", "movingMeshGran", "in.movingMeshGran", 2500.0),
+         ("insert_stream", "insert_stream", "in.insert_stream", 2500.0),
+         ("mesh_tet", "mesh_tet", "in.mesh_tet", 500.0),
+         ("hysteresis", "hysteresis", "in.hysteresis", 2500.0),
+         ("noHysteresis", "hysteresis", "in.noHysteresis", 2500.0),
+         ("cohesion", "cohesion", "in.cohesion", 2500.0),
+         ("noCohesion", "cohesion", "in.noCohesion", 2500.0),
+         ("newModels", "contactModels", "in.newModels", 2500.0))]
 
 
 def prepare(tut: Tutorial, cfdem: Path | None, work: Path) -> Path:

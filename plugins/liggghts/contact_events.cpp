@@ -22,6 +22,12 @@
 // what heat/gran moved during the collision's model time (pyhost.loop.Coupling.harvest). A
 // history is handed over once full, or when its contact ends (collheat_events_histories).
 //
+// With heat/gran the recorder also sums, at every step (not at a run's set-up), the heat the
+// script's sources put into the particles: heat/gran's per-atom heatSource [W], which its
+// transport equation adds to Temp at each step it integrates as source * nevery * dt / (m c)
+// (FixScalarTransportEquation::advanceQtyExplicit, and advanceQtyImplicit's Crank-Nicolson
+// form): the host's energy balance counts it as heat_from_sources (collheat_events_source_heat).
+//
 // With restitution feedback the host gives each open contact the normal separation speed the
 // heat model's restitution asks for (collheat_events_restitution); at the step the contact
 // ends the recorder imposes it on the pair's normal velocity, conserving momentum (as
@@ -58,8 +64,10 @@
 #include "domain.h"
 #include "fix_property_atom.h"
 #include "comm.h"
+#include "fix_property_global.h"
 #define protected public
 #include "fix_heat_gran_conduction.h"
+#include "fix_scalar_transport_equation.h"
 #undef protected
 
 // LIGGGHTS' fix wall/gran, of which the recorder calls one method: its header needs headers
@@ -116,6 +124,8 @@ struct Recorder {
     std::vector<double> appeared;              // atom's id, Temp at its first step (before heat/gran moves any)
                                                // and that step (under MPI an atom that moves in may be
                                                // larger than all this rank saw: the host keeps the first)
+    double source_heat = 0.0;                  // with heat/gran: what its sources put in since the last take [J]
+    bool syncing = false;                      // record() called by the host between runs, not by a step
 
     // The state of the contacts, laid out like the neighbour list (one slot per entry, in
     // the order of ilist and each atom's neighbours) and, for the walls, like the local
@@ -366,6 +376,38 @@ struct Recorder {
         return false;
     }
 
+    // The heat [J] heat/gran's sources put into this rank's atoms at this step, as its transport
+    // equation integrates it (final_integrate, after this fix's post_force: the same atoms).
+    double source_heat_now(bigint step) const
+    {
+        const FixScalarTransportEquation *ste = conduction->fix_ste;
+        if (!ste || !ste->int_flag || !ste->fix_source || step % ste->nevery_) return 0.0;
+        const double *source = ste->fix_source->vector_atom;
+        const Atom *atom = lmp->atom;
+        const int nlocal = atom->nlocal;
+        bool any = false;
+        for (int i = 0; i < nlocal && !any; ++i) any = source[i] != 0.0;
+        if (!any) return 0.0;
+        const double dt = lmp->update->dt, SMALL = 1e-8;      // (fix_scalar_transport_equation.cpp's)
+        double sum = 0.0;
+        for (int i = 0; i < nlocal; ++i) {
+            if (!(atom->mask[i] & ste->groupbit) || source[i] == 0.0) continue;
+            double mc = 1.0;                                  // without a capacity Temp takes source dt
+            if (ste->capacity_flag) {
+                mc = atom->rmass[i] * ste->fix_capacity->compute_vector(atom->type[i] - 1);
+                if (std::fabs(mc / atom->rmass[i]) <= SMALL) continue;
+            }
+            double q = source[i] * double(ste->nevery_) * dt;
+            if (ste->implicitMode_ && ste->fix_transCoeffQty_) {    // the implicit form divides the step's change
+                const double r = atom->radius[i];
+                const double termMP = dt / mc * ste->fix_transCoeffQty_->vector_atom[i] * r * r * 12.5663706144;
+                q /= 1.0 + termMP * ste->crankNicholsonFactor_;
+            }
+            sum += q;
+        }
+        return sum;
+    }
+
     void record(bigint step)
     {
         Atom *atom = lmp->atom;
@@ -404,6 +446,7 @@ struct Recorder {
         }
         size_t k = 0;
         if (conduction) {
+            if (!lmp->update->setupflag && !syncing) source_heat += source_heat_now(step);
             conduction->updatePtrs();                       // its Temp, after any insertion
             tagint top = max_tag;
             for (int i = 0; i < nlocal; ++i)
@@ -647,7 +690,9 @@ void collheat_events_prime(void *handle) { static_cast<Recorder *>(handle)->prim
 void collheat_events_sync(void *handle)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
+    rec->syncing = true;
     rec->record(rec->lmp->update->ntimestep);
+    rec->syncing = false;
 }
 
 // Keep heat/gran's flux through each new pair contact for its first `window` steps: `fix_id`
@@ -660,6 +705,15 @@ int collheat_events_conduction(void *handle, const char *fix_id, int window)
     rec->conduction = static_cast<FixHeatGranCond *>(rec->lmp->modify->fix[f]);
     rec->window = window;
     return 0;
+}
+
+// The heat [J] heat/gran's sources put into this rank's atoms since the last call (0 without heat/gran).
+double collheat_events_source_heat(void *handle)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    const double q = rec->source_heat;
+    rec->source_heat = 0.0;
+    return q;
 }
 
 // Flux histories handed over and waiting (HEAD + window doubles each); with `all`, first hand

@@ -16,7 +16,7 @@ Hooks, called by the loop on every effect in the list's order (the defaults do n
     row(atoms)     its history values at a frame, in the order of ``columns``
     frame()        its files at a frame
     state()        (JSON values, arrays) for a checkpoint; restore(state) takes them back
-    flush()        its files whole on disk (a checkpoint, the end)
+    flush()        its files whole on disk and its totals up to date (a checkpoint, the end)
     finish(summary, status)   its part of summary.json; an invariant found broken at the end
                    of a completed run goes in ``failure`` (the run then fails, exit 3, after
                    its summary is written and its files closed)

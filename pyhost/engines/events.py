@@ -67,6 +67,7 @@ _DECLARATIONS = {
     "collheat_events_restitution": (None, [_vp, _int, _c.POINTER(_c.c_int64), _dp, _dp]),
     "collheat_events_forget": (None, [_vp, _int, _c.POINTER(_c.c_int64)]),
     "collheat_events_meshes_by_history": (_int, [_vp]),
+    "collheat_events_source_heat": (_c.c_double, [_vp]),
 }
 IMPOSED, MOVED = 1, 2      # the flags column
 HEAD = 4
@@ -106,6 +107,12 @@ class ContactEvents:
         if n:
             raw = raw[:h.collheat_events_appeared(self.handle, raw.ctypes.data_as(_dp), n)]
         return raw[:, 0].astype(np.int64), raw[:, 1], raw[:, 2].astype(np.int64)
+
+    def source_heat(self) -> float:
+        """The heat [J] the script's heat/gran sources (per-atom heatSource [W]) put into the
+        particles since the last call, summed at every step as heat/gran integrates it (0
+        without heat/gran)."""
+        return self.lmp.helper.collheat_events_source_heat(self.handle)
 
     def restitution(self, keys, speed, normal) -> None:
         """Separation speeds [m/s] to impose on open contacts (``pyhost.collisions.contact_keys``)
@@ -209,7 +216,8 @@ class ContactEvents:
             self.handle = None
 
 
-GATHERED = {"take", "histories", "appeared", "primitives", "meshes", "waiting", "open_count", "totals"}
+GATHERED = {"take", "histories", "appeared", "primitives", "meshes", "waiting", "open_count", "totals",
+            "source_heat"}
 """What each rank answers to rank 0 (the others' recorders change only their own state)."""
 
 
@@ -284,6 +292,9 @@ class RankEvents:
 
     def sync(self) -> None:
         self._all("sync")
+
+    def source_heat(self) -> float:
+        return float(sum(self._all("source_heat")))       # (in rank order)
 
     def restitution(self, keys, speed, normal) -> None:
         self._all("restitution", np.asarray(keys), np.asarray(speed), np.asarray(normal))

@@ -317,6 +317,23 @@ def test_fluidized_bed_moves_heat_on_each_rank_at_its_exchanges(tmp_path):
         assert np.nanmax(np.abs(a[column] - b[column])) < 1e-9, column
 
 
+def test_heat_sources_on_two_ranks_sum_as_serially(tmp_path):
+    """Debian's heatTransfer_2 (heat/gran's per-atom heat sources) on two ranks: each rank's
+    recorder sums the heat its own atoms' sources put in, and rank 0 adds them up: the same
+    heat_from_sources as the serial run's (to round-off; its atoms are summed in another
+    order), and the balance closes."""
+    from test_user_scripts import SOURCES, heat_sources_case, source_heat_expected
+    if not SOURCES.is_dir():
+        pytest.skip("liggghts-doc is installed by tools/setup_engines.sh")
+    case = heat_sources_case(tmp_path)
+    summary = run(case, tmp_path / "two", 2, "--test")
+    assert grid(tmp_path / "two") != "1 by 1 by 1"
+    expected = source_heat_expected(tmp_path / "two" / "dem" / "log.liggghts", summary["steps"] - 20000)
+    assert expected != 0.0
+    assert summary["heat_from_sources"] == pytest.approx(expected, rel=1e-9)
+    assert abs(summary["energy_balance_error"]) < 1e-12
+
+
 def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
     """hot-cold-box --test on two ranks with a checkpoint every 4 ms, rank 0 killed outright at
     step 6003 (mpirun ends the job) and continued with --restart on two ranks: collisions.csv,
