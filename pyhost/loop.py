@@ -347,13 +347,17 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     last_run = max((k for k, c in enumerate(commands) if c.name == "run"), default=-1)
     prepared = None
 
+    held = []                           # the reset_timestep commands right before the first run
+
     def prepare(cmd):
         try:
             added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
-                                fluid_force=fluid is not None)
+                                fluid_force=fluid is not None, then=held)
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
-        log("host adds to the script: " + ("; ".join(added) if added else "nothing"))
+        log("host adds to the script: " + ("; ".join(added) if added else "nothing")
+            + (f" (before {held[0].where()}'s reset_timestep: LIGGGHTS takes no new fix between a restart's "
+               "reset_timestep and its run)" if added and held else ""))
         return added
 
     try:
@@ -361,7 +365,12 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             if cmd.name != "run":
                 if k == 0 or commands[k - 1].name == "run":     # the commands up to the next run
                     upto = next((m for m in range(k, len(commands)) if commands[m].name == "run"), len(commands))
-                    dem.commands(commands[k:upto])
+                    cut = upto
+                    while prepared is None and upto < len(commands) and cut > k \
+                            and commands[cut - 1].name == "reset_timestep":
+                        cut -= 1                # the host's fixes go in before them (prepare)
+                    held[:] = commands[cut:upto]
+                    dem.commands(commands[k:cut])
                 continue
             dem.context(cmd)
             run = parse_run(cmd)

@@ -2,7 +2,8 @@
 """Run public tutorials nobody here wrote through the host, as a user would, and check
 their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI and packedBedTemp, and
 Debian's liggghts-doc tutorials (packing, heatTransfer_1 and _2, chute_wear, conveyor,
-meshGran, movingMeshGran, insert_stream, mesh_tet, hysteresis, cohesion, contactModels).
+meshGran, movingMeshGran, insert_stream and its restart, mesh_tet, hysteresis, cohesion,
+contactModels).
 
 The tutorials are not part of this repository (their licences are theirs, and fetched
 content is never committed): point ``--cfdem`` at a CFDEMcoupling-PUBLIC checkout; Debian's
@@ -261,6 +262,9 @@ TUTORIALS = [
              checks=liggghts_checks),
     Tutorial("heatTransfer_2", "liggghts", "heatTransfer_2", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),
              checks=sources_checks),
+    Tutorial("insert_stream_reset", "liggghts", "insert_stream", ".",       # reads the restart of its first
+             liggghts_scene("in.insert_stream_reset_timestep", 2500.0),    # script: reset_timestep, then run
+             native_first=(".", "in.insert_stream"), checks=liggghts_checks),
 ] + [Tutorial(name, "liggghts", folder, ".", liggghts_scene(script, density), checks=liggghts_checks)
      for name, folder, script, density in (          # Debian's, run as they are; density = the script's
          ("packing", "packing", "in.packing", 2500.0),
@@ -310,12 +314,12 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     args.work.mkdir(parents=True, exist_ok=True)
     failed = 0
-    print(f"{'tutorial':<16} {'rc':>3} {'wall s':>7}  check: value (reference, tolerance)")
+    print(f"{'tutorial':<20} {'rc':>3} {'wall s':>7}  check: value (reference, tolerance)")
     for tut in TUTORIALS:
         if args.only and tut.name not in args.only:
             continue
         if tut.origin == "cfdem" and args.cfdem is None:
-            print(f"{tut.name:<16}   -       -  not run: no --cfdem checkout given")
+            print(f"{tut.name:<20}   -       -  not run: no --cfdem checkout given")
             continue
         copy = prepare(tut, args.cfdem, args.work)
         if tut.native_first:
@@ -330,12 +334,12 @@ def main(argv=None) -> int:
         checks = tut.checks(copy, out) if r.returncode == 0 and tut.checks and not args.test else []
         bad = r.returncode != 0 or not all(c.ok for c in checks)
         failed += bad
-        first = f"{tut.name:<16} {r.returncode:>3} {wall:7.1f}"
+        first = f"{tut.name:<20} {r.returncode:>3} {wall:7.1f}"
         if r.returncode:
             tail = (r.stderr.strip().splitlines() or ["(no message)"])[-1]
             print(f"{first}  FAILED: {tail} (log: {copy / 'host.log'})")
         for k, c in enumerate(checks):
-            print(f"{first if k == 0 else '':<28}  {c}")
+            print(f"{first if k == 0 else '':<32}  {c}")
     return 1 if failed else 0
 
 

@@ -138,9 +138,12 @@ class Dem:
             raise ScriptError(f"run {steps}{' upto' if upto else ''}: {why} (LIGGGHTS: 'Invalid run command')")
         return n
 
-    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False) -> list[str]:
+    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
+                then: list[Command] = ()) -> list[str]:
         """What the host adds before the first run: the Temp property (if no fix heat/gran or
-        property/atom Temp made it), the contact event recorder's fix and the fluid force.
+        property/atom Temp made it), the contact event recorder's fix and the fluid force;
+        then the script's commands ``then`` (its reset_timestep right before the first run:
+        after a read_restart LIGGGHTS refuses a new fix between the two) and the run's set-up.
         ``contacts``: whether the loop needs the contacts (default: with heat). Returns the
         added commands (printed once)."""
         from pyhost.engines.events import fix_command
@@ -160,6 +163,8 @@ class Dem:
             self.events = ContactEvents(self.lmp) if self.link is None else RankEvents(self.lmp, self.link)
             if heat and self.info.heat_gran:
                 self.events.conduction(self.info.heat_gran, HEAT_GRAN_WINDOW)
+        if then:
+            self.commands(list(then))
         self.run(0)
         if fluid_force:         # the set-up added fix external's array while it was uninitialised
             self.set_force(np.zeros((self.count(), 3)))     # memory: zero it and set up again

@@ -46,9 +46,11 @@ class DemEngine(Protocol):
     def engine_command(self, line: str) -> None:
         """Run a command of the host's own (write_restart, ...)."""
 
-    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False) -> list[str]:
+    def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
+                then=()) -> list[str]:
         """Before the first run: add what the host needs (temperatures, the contact event
-        recorder, the external force); returns the commands added, for the log."""
+        recorder, the external force), run the script's commands ``then`` (held back to come
+        after them) and set up; returns the commands added, for the log."""
 
     def steps(self, steps: str, upto: bool) -> int:
         """The number of steps of a script's ``run N [upto]``."""

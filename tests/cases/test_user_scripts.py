@@ -16,6 +16,7 @@ pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
 TUTORIAL = Path("/usr/share/doc/liggghts/examples/LIGGGHTS/Tutorials_public/heatTransfer_1")
 SOURCES = TUTORIAL.parent / "heatTransfer_2"
+STREAM = TUTORIAL.parent / "insert_stream"
 
 STEEL = """
 [materials.steel]
@@ -113,6 +114,33 @@ def test_debian_heat_source_tutorial_closes_its_balance_with_the_sources_heat(tm
     assert expected != 0.0
     assert summary["heat_from_sources"] == pytest.approx(expected, rel=1e-9)
     assert abs(summary["energy_balance_error"]) < 1e-12
+
+
+@pytest.mark.skipif(not STREAM.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
+def test_debian_restart_with_reset_timestep_before_its_first_run_runs_unchanged(tmp_path):
+    """insert_stream's second script reads the restart the first writes, then 'reset_timestep 0',
+    'reset_timestep 50000' and 'run 1'. After a read_restart LIGGGHTS refuses a new fix between
+    reset_timestep and run ('must come immediately before run'), which is where the host added
+    its fixes: the run ended at once (exit 2). The host now adds them before the resets, which
+    still take effect: the run goes on from step 50000 (0.5 s at its 1e-5 s step)."""
+    case = tmp_path / "insert_stream"
+    shutil.copytree(STREAM, case)
+    first = subprocess.run(["liggghts", "-in", "in.insert_stream", "-screen", "/dev/null"], cwd=case, capture_output=True,
+                           text=True, timeout=300)
+    assert first.returncode == 0 and (case / "post" / "liggghts.restart").exists(), first.stdout[-2000:]
+    (case / "case.toml").write_text('[dem]\nscript = "in.insert_stream_reset_timestep"\n[effects]\ncontact_heat = "A"\n'
+                                    "[materials.glass]\ntypes = [1]\ntemperature = 300.0\ndensity = 2500.0\n"
+                                    "youngs_modulus = 63e9\npoisson_ratio = 0.25\nyield_stress = 500e6\n"
+                                    "heat_capacity = 840.0\nconductivity = 1.0\n"
+                                    "[time]\ntest_end = 0.03\n[output]\nvtk = false\npictures = false\n")
+    r, summary = run(case, "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "reset_timestep: LIGGGHTS takes no new fix between" in r.stdout
+    assert summary["steps"] == 3000 and summary["time"] == pytest.approx(0.53)
+    assert abs(summary["energy_balance_error"]) < 1e-12
+    with open(case / "out" / "collisions.csv") as f:
+        times = [float(row["time"]) for row in csv.DictReader(f)]
+    assert times and min(times) > 0.5, times[:3]
 
 
 @pytest.fixture(scope="module")
