@@ -93,6 +93,10 @@ def read_script(path: str | Path, folder: str | Path | None = None, _depth: int 
             _check_if(cmd)
         if cmd.name == "delete_atoms":
             _check_delete(cmd)
+        if cmd.name == "fix" and any(w.split("/")[-1] == "multisphere" for w in cmd.text.split()[3:4]):
+            raise ScriptError(f"{cmd.where()}: fix {cmd.text.split()[3]}: rigid clumps of spheres (multisphere) "
+                              "are not supported: the collision heat models and the energy balance take each "
+                              "atom for a sphere of its own mass, and a clump's spheres carry the clump's")
         if cmd.name == "run":
             parse_run(cmd)              # 'run ... every' and other forms refused before any engine time
         if cmd.name == "include":
@@ -239,9 +243,9 @@ def parse_run(cmd: Command) -> RunCommand:
 
 @dataclass(frozen=True)
 class GranWall:
-    """A ``fix ID group wall/gran ...``: a primitive wall (``geometry`` = (kind, numbers),
-    kind xplane, yplane, zplane, xcylinder, ycylinder or zcylinder) or mesh walls
-    (``meshes``: ids of their fix mesh/surface)."""
+    """A ``fix ID group wall/gran ...``: a primitive wall (``primitive`` = (kind, numbers),
+    kind xplane, yplane, zplane, xcylinder, ycylinder or zcylinder; numbers None where the
+    script gives them as variables) or mesh walls (``meshes``: ids of their fix mesh/surface)."""
 
     fix: str
     primitive: tuple | None = None
@@ -260,11 +264,14 @@ def parse_wall(cmd: Command) -> GranWall | None:
         try:
             wall_type = int(w[w.index("type", k) + 1])
             kind = next(x for x in w[k:] if x in PRIMITIVES)
-            at = w.index(kind, k)
-            numbers = tuple(float(x) for x in w[at + 1: at + 1 + PRIMITIVES[kind]])
         except (ValueError, StopIteration, IndexError):
             raise ScriptError(f"{cmd.where()}: primitive wall the host cannot read (supported: "
-                              f"{', '.join(PRIMITIVES)} with plain numbers)") from None
+                              f"{', '.join(PRIMITIVES)}, with a plain number after 'type')") from None
+        at = w.index(kind, k)
+        try:                            # (LIGGGHTS has the geometry, the contact recorder reads it
+            numbers = tuple(float(x) for x in w[at + 1: at + 1 + PRIMITIVES[kind]])    # from its fix:
+        except ValueError:              # a ${variable} position is fine)
+            numbers = None
         return GranWall(w[1], primitive=(kind, numbers), type=wall_type,
                         moving=any(x in w for x in ("wiggle", "shear", "rotate")))
     if "meshes" in w:

@@ -3,7 +3,7 @@
 their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI and packedBedTemp, and
 Debian's liggghts-doc tutorials (packing, heatTransfer_1 and _2, chute_wear, conveyor,
 meshGran, movingMeshGran, insert_stream and its restart, mesh_tet, hysteresis, cohesion,
-contactModels).
+contactModels, hydrogel_multicontact's default).
 
 The tutorials are not part of this repository (their licences are theirs, and fetched
 content is never committed): point ``--cfdem`` at a CFDEMcoupling-PUBLIC checkout; Debian's
@@ -209,7 +209,7 @@ def sources_checks(w: Path, out: Path) -> list[Check]:
 
 MATERIAL = """
 [materials.beads]                   # real values for the contact models (not in the tutorial)
-types = [1]
+types = {types}
 temperature = {T}                   # 0: the script's own (its fix heat/gran)
 density = {density}                 # = the script's particle density (checked)
 youngs_modulus = 63e9
@@ -235,12 +235,13 @@ void_fraction = "divided"           # couplingProperties: voidFractionModel divi
 
 [time]
 couple_every = 100                  # the script's couple/cfd couple_every
-""" + MATERIAL.format(density=density, cp=cp, T=T)
+""" + MATERIAL.format(density=density, cp=cp, T=T, types="[1]")
 
 
-def liggghts_scene(script: str, density: float, *, cp: float = 840.0, T: float = 300.0) -> str:
+def liggghts_scene(script: str, density: float, *, cp: float = 840.0, T: float = 300.0, types: str = "[1]") -> str:
     """The case.toml beside a Debian LIGGGHTS tutorial's script."""
-    return f'[dem]\nscript = "{script}"\n\n[effects]\ncontact_heat = "A"\n' + MATERIAL.format(density=density, cp=cp, T=T)
+    return (f'[dem]\nscript = "{script}"\n\n[effects]\ncontact_heat = "A"\n'
+            + MATERIAL.format(density=density, cp=cp, T=T, types=types))
 
 
 TUTORIALS = [
@@ -265,6 +266,9 @@ TUTORIALS = [
     Tutorial("insert_stream_reset", "liggghts", "insert_stream", ".",       # reads the restart of its first
              liggghts_scene("in.insert_stream_reset_timestep", 2500.0),    # script: reset_timestep, then run
              native_first=(".", "in.insert_stream"), checks=liggghts_checks),
+    Tutorial("hydrogel", "liggghts", "hydrogel_multicontact", ".",          # walls at ${sizeX}, a piston;
+             liggghts_scene("in.hydrogel_default", 11.5, types="[1, 2]"),  # its data file's density
+             checks=liggghts_checks),
 ] + [Tutorial(name, "liggghts", folder, ".", liggghts_scene(script, density), checks=liggghts_checks)
      for name, folder, script, density in (          # Debian's, run as they are; density = the script's
          ("packing", "packing", "in.packing", 2500.0),

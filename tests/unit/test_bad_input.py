@@ -58,6 +58,9 @@ def test_cli_bad_input_one_line_exit_2(args, word):
     ("run 100 every 10 \"print x\"", "'run ... every' is not supported by the host"),
     ("delete_atoms region out", "'delete_atoms' renumbers the remaining atoms' ids .* add 'compress no'"),
     ("delete_atoms region out compress yes", "'delete_atoms' renumbers"),
+    ("fix integr all multisphere", "fix multisphere: rigid clumps of spheres .* are not supported"),
+    ("fix pts1 all particletemplate/multisphere 15485863 atom_type 1 density constant 2500 nspheres 50",
+     "fix particletemplate/multisphere: rigid clumps"),
 ])
 def test_script_commands_the_host_cannot_couple_are_refused_when_read(tmp_path, line, message):
     """Found when the script is read, before any engine time, wherever they stand (an 'if'
@@ -78,3 +81,20 @@ def test_delete_atoms_keeping_the_ids_is_read(tmp_path):
     (tmp_path / "in.x").write_text("run 10\ndelete_atoms region out compress no\nrun 10\n")
     assert [c.text for c in read_script(tmp_path / "in.x")] == ["run 10", "delete_atoms region out compress no",
                                                                  "run 10"]
+
+
+def test_a_primitive_wall_placed_by_a_variable_is_read():
+    """Debian's hydrogel tutorial places its walls at ${sizeX}: LIGGGHTS has the geometry (the
+    contact recorder reads it from the fix), the host needs only the wall's kind and type; it
+    used to refuse the script ("primitive wall the host cannot read")."""
+    from pyhost.script import Command, ScriptError, parse_wall
+
+    wall = parse_wall(Command("fix wall_right all wall/gran model hertz tangential history primitive type 2 "
+                              "xplane ${sizeX}", "in.x", 5))
+    assert wall.primitive == ("xplane", None) and wall.type == 2
+    plain = parse_wall(Command("fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0",
+                               "in.x", 6))
+    assert plain.primitive == ("zplane", (0.0,))
+    with pytest.raises(ScriptError, match=r"in.x:7: primitive wall the host cannot read"):
+        parse_wall(Command("fix w all wall/gran model hertz tangential history primitive type ${t} zplane 0.0",
+                           "in.x", 7))
