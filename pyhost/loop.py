@@ -353,8 +353,8 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
         try:
             added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
                                 fluid_force=fluid is not None, then=held)
-        except LiggghtsError as exc:
-            raise LiggghtsError(f"{cmd.where()} (the first run): {exc}") from None
+        except (LiggghtsError, ScriptError) as exc:
+            raise type(exc)(f"{cmd.where()} (the first run): {exc}") from None
         log("host adds to the script: " + ("; ".join(added) if added else "nothing")
             + (f" (before {held[0].where()}'s reset_timestep: LIGGGHTS takes no new fix between a restart's "
                "reset_timestep and its run)" if added and held else ""))

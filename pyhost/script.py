@@ -93,6 +93,9 @@ def read_script(path: str | Path, folder: str | Path | None = None, _depth: int 
             _check_if(cmd)
         if cmd.name == "delete_atoms":
             _check_delete(cmd)
+        if cmd.name == "units" and cmd.text.split()[1:] != ["si"]:
+            raise ScriptError(f"{cmd.where()}: '{cmd.text}': the host's contact models, heat and energy balance "
+                              "are in SI; give 'units si' (and the script's values in SI)")
         if cmd.name == "fix" and any(w.split("/")[-1] == "multisphere" for w in cmd.text.split()[3:4]):
             raise ScriptError(f"{cmd.where()}: fix {cmd.text.split()[3]}: rigid clumps of spheres (multisphere) "
                               "are not supported: the collision heat models and the energy balance take each "

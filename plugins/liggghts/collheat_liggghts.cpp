@@ -233,6 +233,9 @@ double *collheat_fix_external_force(void *ptr, const char *id)
     return f->fexternal ? f->fexternal[0] : nullptr;
 }
 
+// LIGGGHTS' unit style now ("si", "cgs", "lj", ...: a units command, a restart file's, or the default).
+const char *collheat_unit_style(void *ptr) { return static_cast<LAMMPS *>(ptr)->update->unit_style; }
+
 // The interval [steps] of the script's most frequent dump with a fixed interval; 0 if none.
 int collheat_dump_every(void *ptr)
 {

@@ -148,6 +148,11 @@ class Dem:
         added commands (printed once)."""
         from pyhost.engines.events import fix_command
 
+        units = self.lmp.unit_style()
+        if units != "si":       # (a read_restart brings its file's units, a script without any LIGGGHTS' lj)
+            raise ScriptError(f"the script runs in LIGGGHTS' units {units}: the host's contact models, heat and "
+                              "energy balance are in SI; give 'units si' before the box (and the script's values "
+                              "in SI)")
         contacts = heat if contacts is None else contacts
         added = []
         if heat and not self.info.temp_fix and not self.info.heat_gran:

@@ -70,6 +70,7 @@ _HELPER_DECLARATIONS = {
     "collheat_random_state": (_int, [_vp, _cp, _cp, _c.POINTER(_int), _int]),
     "collheat_keep_mesh_bins": (_int, [_vp]),
     "collheat_dump_every": (_int, [_vp]),
+    "collheat_unit_style": (_cp, [_vp]),
 }
 
 # Per-atom arrays: name -> (ctype, columns; 0 for a vector).
@@ -403,6 +404,11 @@ class Liggghts:
         """Current time step number."""
         raw = self.lib.lammps_extract_global(self.ptr, b"ntimestep")
         return ctypes.cast(raw, ctypes.POINTER(ctypes.c_int64))[0]
+
+    def unit_style(self) -> str:
+        """LIGGGHTS' unit style now: the script's ``units``, a restart file's, or LIGGGHTS'
+        default (lj)."""
+        return self.helper.collheat_unit_style(self.ptr).decode()
 
     def dump_every(self) -> int:
         """The interval [steps] of the most frequent dump defined now with a fixed interval

@@ -116,6 +116,16 @@ def test_material_of_a_type_the_script_does_not_create_is_refused_before_the_eng
     assert s is None and "host adds to the script" not in r.stdout     # no engine time spent
 
 
+def test_a_script_without_units_si_is_refused_at_its_first_run(tmp_path):
+    """Without a units command LIGGGHTS runs in lj units (a read_restart brings its file's): the
+    host would read its lengths, masses and speeds as SI and give heat with exit 0. It reads
+    LIGGGHTS' own unit style at the first run and refuses anything but si, before a step."""
+    r, s = run(tmp_path, header().replace("units si\n", "") + "run 100\n", toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "in.run:24 (the first run): the script runs in LIGGGHTS' units lj" in r.stderr, r.stderr
+    assert s is None
+
+
 def test_particles_at_zero_kelvin_are_refused(tmp_path):
     """No fix heat/gran and no material temperature: the particles would start at 0 K."""
     r, _ = run(tmp_path, header() + "run 100\n", toml(temperature=""))

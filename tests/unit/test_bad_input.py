@@ -58,6 +58,7 @@ def test_cli_bad_input_one_line_exit_2(args, word):
     ("run 100 every 10 \"print x\"", "'run ... every' is not supported by the host"),
     ("delete_atoms region out", "'delete_atoms' renumbers the remaining atoms' ids .* add 'compress no'"),
     ("delete_atoms region out compress yes", "'delete_atoms' renumbers"),
+    ("units cgs", "'units cgs': the host's contact models, heat and energy balance are in SI"),
     ("fix integr all multisphere", "fix multisphere: rigid clumps of spheres .* are not supported"),
     ("fix pts1 all particletemplate/multisphere 15485863 atom_type 1 density constant 2500 nspheres 50",
      "fix particletemplate/multisphere: rigid clumps"),
