@@ -39,7 +39,8 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
     on the box's sides at their fixed temperature, the other walls adiabatic."""
     from foamlib import FoamFile
 
-    from pyhost.engines.fluid_case import add_final_solvers, adopt_void_fraction, box_case, case_density
+    from pyhost.engines.fluid_case import (add_final_solvers, adopt_piso, adopt_void_fraction, box_case,
+                                           case_density)
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
@@ -50,6 +51,8 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
         shutil.copytree(source, folder, symlinks=True, ignore=_case_copy_filter(folder))
         adopt_void_fraction(folder)
         add_final_solvers(folder)
+        if adopt_piso(folder):
+            print("fluid case: fvSolution's PISO settings run as collheatFoam's PIMPLE (one outer corrector)")
         props = FoamFile(folder / "constant" / "transportProperties")
         rho, where = case_density(folder)
         if where.startswith("0/rho"):   # collheatFoam reads rho beside nu

@@ -209,6 +209,25 @@ def adopt_void_fraction(case: str | Path) -> bool:
     return True
 
 
+def adopt_piso(case: str | Path) -> bool:
+    """In a copy of a user's case: CFDEM's solvers (cfdemSolverPiso, cfdemSolverPisoScalar, ...)
+    and pisoFoam read their loop from fvSolution's PISO dictionary, collheatFoam from PIMPLE.
+    Where the case's application is such a PISO solver, or the case has PISO and no PIMPLE,
+    PIMPLE becomes PISO's entries (nCorrectors, nNonOrthogonalCorrectors, pRefCell,
+    pRefValue, ...) with one outer corrector: PIMPLE run as PISO, with the user's settings.
+    Returns True if it did."""
+    f = FoamFile(Path(case) / "system" / "fvSolution")
+    if "PISO" not in f:
+        return False
+    application = str(FoamFile(Path(case) / "system" / "controlDict").get("application", ""))
+    if "PIMPLE" in f and "piso" not in application.lower():
+        return False
+    loop = dict(f["PISO"])
+    loop["nOuterCorrectors"] = 1
+    f["PIMPLE"] = loop
+    return True
+
+
 def add_final_solvers(case: str | Path) -> list[str]:
     """In a copy of a user's case: OpenFOAM v1912 looks up 'XFinal' solver settings for the
     last corrector of every field X it solves; cases written for older versions (CFDEM's

@@ -63,3 +63,35 @@ def test_copy_of_a_case_holding_runs_leaves_them_out(case):
     shutil.rmtree(copy)
     shutil.copytree(case, copy, ignore=_case_copy_filter(copy))
     assert sorted(p.name for p in copy.iterdir()) == ["0", "case.toml", "constant", "system"]
+
+
+def piso_case(case, application, pimple=None):
+    f = FoamFile(case / "system" / "fvSolution")
+    del f["PIMPLE"]
+    f["PISO"] = {"nCorrectors": 4, "nNonOrthogonalCorrectors": 1, "pRefCell": 0, "pRefValue": 0}
+    if pimple is not None:
+        f["PIMPLE"] = pimple
+    FoamFile(case / "system" / "controlDict")["application"] = application
+
+
+@pytest.mark.parametrize("application, pimple", [("cfdemSolverPiso", {"nOuterCorrectors": 1}),
+                                                 ("cfdemSolverPisoScalar", None), ("collheatFoam", None)])
+def test_a_piso_solvers_settings_run_as_pimple(case, application, pimple):
+    """CFDEM's solvers read PISO (ErgunTestMPI: 4 correctors, 1 non-orthogonal corrector on its
+    O-grid; collheatFoam ran PIMPLE's defaults, 1 and 0, and its bed's pressure drop was 6 %
+    below the drag law's, 0.05 % with them). PIMPLE becomes PISO's entries, one outer loop."""
+    from pyhost.engines.fluid_case import adopt_piso
+
+    piso_case(case, application, pimple)
+    assert adopt_piso(case)
+    loop = dict(FoamFile(case / "system" / "fvSolution")["PIMPLE"])
+    assert loop == {"nCorrectors": 4, "nNonOrthogonalCorrectors": 1, "pRefCell": 0, "pRefValue": 0,
+                    "nOuterCorrectors": 1}
+
+
+def test_a_pimple_solvers_own_pimple_stays(case):
+    from pyhost.engines.fluid_case import adopt_piso
+
+    piso_case(case, "cfdemSolverPimple", {"nOuterCorrectors": 3, "nCorrectors": 2})
+    assert not adopt_piso(case)
+    assert dict(FoamFile(case / "system" / "fvSolution")["PIMPLE"]) == {"nOuterCorrectors": 3, "nCorrectors": 2}
