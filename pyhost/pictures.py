@@ -41,7 +41,11 @@ def plot_history(out: Path) -> Path:
         ax1.plot(t * 1e3, T - T[seen[0]], label=f"{name} (from {T[seen[0]]:.5g} K)")
     ax1.set_xlabel("time [ms]")
     ax1.set_ylabel("mean temperature change [K]")
-    ax1.legend()
+    if ax1.lines:
+        ax1.legend()
+    else:                                   # no particle temperatures (a dry, isothermal scene)
+        ax1.text(0.5, 0.5, "no particle temperatures in this scene", ha="center", va="center",
+                 transform=ax1.transAxes)
     ax1.grid(alpha=0.3)
     ax2.plot(t * 1e3, [int(r["collisions"]) for r in rows])
     ax2.set_xlabel("time [ms]")
