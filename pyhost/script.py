@@ -96,10 +96,11 @@ def read_script(path: str | Path, folder: str | Path | None = None, _depth: int 
         if cmd.name == "units" and cmd.text.split()[1:] != ["si"]:
             raise ScriptError(f"{cmd.where()}: '{cmd.text}': the host's contact models, heat and energy balance "
                               "are in SI; give 'units si' (and the script's values in SI)")
-        if cmd.name == "fix" and any(w.split("/")[-1] == "multisphere" for w in cmd.text.split()[3:4]):
-            raise ScriptError(f"{cmd.where()}: fix {cmd.text.split()[3]}: rigid clumps of spheres (multisphere) "
-                              "are not supported: the collision heat models and the energy balance take each "
-                              "atom for a sphere of its own mass, and a clump's spheres carry the clump's")
+        style = cmd.text.split()[3] if cmd.name == "fix" and len(cmd.text.split()) > 3 else ""
+        if style.split("/")[-1] == "multisphere":
+            raise ScriptError(f"{cmd.where()}: fix {style}: rigid clumps of spheres (multisphere) are not "
+                              "supported: the collision heat models and the energy balance take each atom for a "
+                              "sphere of its own mass, and a clump's spheres carry the whole clump's")
         if cmd.name == "run":
             parse_run(cmd)              # 'run ... every' and other forms refused before any engine time
         if cmd.name == "include":
@@ -270,10 +271,12 @@ def parse_wall(cmd: Command) -> GranWall | None:
         except (ValueError, StopIteration, IndexError):
             raise ScriptError(f"{cmd.where()}: primitive wall the host cannot read (supported: "
                               f"{', '.join(PRIMITIVES)}, with a plain number after 'type')") from None
+        # LIGGGHTS has the geometry and the contact recorder reads it from the fix: a position
+        # given as a ${variable} is fine, the host keeps no numbers then
         at = w.index(kind, k)
-        try:                            # (LIGGGHTS has the geometry, the contact recorder reads it
-            numbers = tuple(float(x) for x in w[at + 1: at + 1 + PRIMITIVES[kind]])    # from its fix:
-        except ValueError:              # a ${variable} position is fine)
+        try:
+            numbers = tuple(float(x) for x in w[at + 1: at + 1 + PRIMITIVES[kind]])
+        except ValueError:
             numbers = None
         return GranWall(w[1], primitive=(kind, numbers), type=wall_type,
                         moving=any(x in w for x in ("wiggle", "shear", "rotate")))

@@ -17,8 +17,9 @@ TOTAL_COLUMNS = ("heat_from_walls", "energy_in", "energy_out", "collisions", "ca
 
 
 class Frames(Effect):
-    """The T_group columns: the loop's ``known`` groups; ``others``: the effects whose columns follow, in order; ``logs``: the checkpoint's output
-    marks to continue from (None: a new run)."""
+    """The T_group columns: the loop's ``known`` groups; ``others``: the effects whose columns
+    follow, in order; ``logs``: the checkpoint's output marks to continue from (None: a new
+    run)."""
 
     def __init__(self, loop, others, logs: dict | None = None):
         super().__init__(loop)
