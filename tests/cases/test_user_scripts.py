@@ -116,6 +116,34 @@ def test_debian_heat_source_tutorial_closes_its_balance_with_the_sources_heat(tm
     assert abs(summary["energy_balance_error"]) < 1e-12
 
 
+@pytest.mark.skipif(not SOURCES.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
+def test_heat_gran_script_with_sources_restarts_bit_for_bit(tmp_path):
+    """heatTransfer_2 (fix heat/gran conducting, its sources on) stopped by SIGTERM at 0.5625 s,
+    after the sources were set, and restarted: collisions.csv, history.csv and summary.json
+    (heat_from_sources included) equal to the last bit those of the run that wrote its periodic
+    checkpoint at that step (0.575 s, the end of the chunk) and went on."""
+    from conftest import STOPPER
+
+    case = heat_sources_case(tmp_path)
+    text = (case / "case.toml").read_text().replace("test_end = 0.55", "test_end = 0.6")
+    (case / "case.toml").write_text(text.replace("[output]\n", "[output]\ncheckpoint = 0.575\n"))
+    r, whole = run(case, "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "checkpoint at t = 0.575 s (step 23000)" in r.stdout
+    cut = tmp_path / "cut"
+    stopped = subprocess.run([sys.executable, "-c", STOPPER, "22500", "SIGTERM", "run", str(case), "--test",
+                              "--out", str(cut)], capture_output=True, text=True, cwd=ROOT, timeout=900)
+    assert stopped.returncode == 128 + 15, stopped.stdout[-3000:] + stopped.stderr[-3000:]
+    assert "checkpoint at t = 0.575 s (step 23000)" in stopped.stdout
+    again = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--test", "--out", str(cut),
+                            "--restart"], capture_output=True, text=True, cwd=ROOT, timeout=900)
+    assert again.returncode == 0, again.stdout[-3000:] + again.stderr[-3000:]
+    for name in ("collisions.csv", "history.csv"):
+        assert (cut / name).read_bytes() == (case / "out" / name).read_bytes(), name
+    restarted = json.loads((cut / "summary.json").read_text())
+    assert restarted == whole and whole["heat_from_sources"] != 0.0
+
+
 @pytest.mark.skipif(not STREAM.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
 def test_debian_restart_with_reset_timestep_before_its_first_run_runs_unchanged(tmp_path):
     """insert_stream's second script reads the restart the first writes, then 'reset_timestep 0',
