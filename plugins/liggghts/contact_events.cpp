@@ -22,11 +22,13 @@
 // what heat/gran moved during the collision's model time (pyhost.loop.Coupling.harvest). A
 // history is handed over once full, or when its contact ends (collheat_events_histories).
 //
-// With heat/gran the recorder also sums, at every step (not at a run's set-up), the heat the
-// script's sources put into the particles: heat/gran's per-atom heatSource [W], which its
-// transport equation adds to Temp at each step it integrates as source * nevery * dt / (m c)
-// (FixScalarTransportEquation::advanceQtyExplicit, and advanceQtyImplicit's Crank-Nicolson
-// form): the host's energy balance counts it as heat_from_sources (collheat_events_source_heat).
+// With heat/gran the recorder also sums, at every step (not at a run's set-up), what its
+// transport equation adds to the particles' m c Temp when it integrates (final_integrate, after
+// this fix's post_force; FixScalarTransportEquation::advanceQtyExplicit, and
+// advanceQtyImplicit's Crank-Nicolson form): the script's sources, per-atom heatSource [W] *
+// nevery * dt, and its conduction, heatFlux [W] * dt, whose pair terms cancel, so that its sum
+// is what heat/gran's walls with a temperature conducted in. The host's energy balance counts
+// them as heat_from_sources and heat_from_script_walls (collheat_events_heat_gran_heat).
 //
 // With restitution feedback the host gives each open contact the normal separation speed the
 // heat model's restitution asks for (collheat_events_restitution); at the step the contact
@@ -125,6 +127,8 @@ struct Recorder {
                                                // and that step (under MPI an atom that moves in may be
                                                // larger than all this rank saw: the host keeps the first)
     double source_heat = 0.0;                  // with heat/gran: what its sources put in since the last take [J]
+    double flux_heat = 0.0;                    // and what its conduction did (its walls' share) [J]
+    std::vector<double> capacity;              // heat/gran's thermalCapacity by atom type (scratch)
     bool syncing = false;                      // record() called by the host between runs, not by a step
 
     // The state of the contacts, laid out like the neighbour list (one slot per entry, in
@@ -376,36 +380,34 @@ struct Recorder {
         return false;
     }
 
-    // The heat [J] heat/gran's sources put into this rank's atoms at this step, as its transport
-    // equation integrates it (final_integrate, after this fix's post_force: the same atoms).
-    double source_heat_now(bigint step) const
+    // What heat/gran's transport equation adds to this rank's atoms' m c Temp at this step [J]:
+    // from the sources (to ``source``) and from the conduction flux (to ``flux``), summed over
+    // the atoms it integrates, as it integrates them (its group, nevery, capacity test).
+    void heat_gran_now(bigint step, double &source_sum, double &flux_sum)
     {
         const FixScalarTransportEquation *ste = conduction->fix_ste;
-        if (!ste || !ste->int_flag || !ste->fix_source || step % ste->nevery_) return 0.0;
-        const double *source = ste->fix_source->vector_atom;
+        if (!ste || !ste->int_flag || !ste->fix_source || !ste->fix_flux || step % ste->nevery_) return;
+        const double *source = ste->fix_source->vector_atom, *flux = ste->fix_flux->vector_atom;
         const Atom *atom = lmp->atom;
         const int nlocal = atom->nlocal;
-        bool any = false;
-        for (int i = 0; i < nlocal && !any; ++i) any = source[i] != 0.0;
-        if (!any) return 0.0;
         const double dt = lmp->update->dt, SMALL = 1e-8;      // (fix_scalar_transport_equation.cpp's)
-        double sum = 0.0;
+        capacity.assign(atom->ntypes + 1, 1.0);               // without a capacity Temp takes q dt
+        if (ste->capacity_flag)
+            for (int t = 1; t <= atom->ntypes; ++t) capacity[t] = ste->fix_capacity->compute_vector(t - 1);
         for (int i = 0; i < nlocal; ++i) {
-            if (!(atom->mask[i] & ste->groupbit) || source[i] == 0.0) continue;
-            double mc = 1.0;                                  // without a capacity Temp takes source dt
-            if (ste->capacity_flag) {
-                mc = atom->rmass[i] * ste->fix_capacity->compute_vector(atom->type[i] - 1);
-                if (std::fabs(mc / atom->rmass[i]) <= SMALL) continue;
-            }
-            double q = source[i] * double(ste->nevery_) * dt;
+            if (!(atom->mask[i] & ste->groupbit) || (source[i] == 0.0 && flux[i] == 0.0)) continue;
+            const double c = capacity[atom->type[i]];
+            if (ste->capacity_flag && std::fabs(c) <= SMALL) continue;
+            const double mc = ste->capacity_flag ? atom->rmass[i] * c : 1.0;
+            double scale = dt;
             if (ste->implicitMode_ && ste->fix_transCoeffQty_) {    // the implicit form divides the step's change
                 const double r = atom->radius[i];
                 const double termMP = dt / mc * ste->fix_transCoeffQty_->vector_atom[i] * r * r * 12.5663706144;
-                q /= 1.0 + termMP * ste->crankNicholsonFactor_;
+                scale /= 1.0 + termMP * ste->crankNicholsonFactor_;
             }
-            sum += q;
+            source_sum += source[i] * double(ste->nevery_) * scale;
+            flux_sum += flux[i] * scale;
         }
-        return sum;
     }
 
     void record(bigint step)
@@ -446,7 +448,7 @@ struct Recorder {
         }
         size_t k = 0;
         if (conduction) {
-            if (!lmp->update->setupflag && !syncing) source_heat += source_heat_now(step);
+            if (!lmp->update->setupflag && !syncing) heat_gran_now(step, source_heat, flux_heat);
             conduction->updatePtrs();                       // its Temp, after any insertion
             tagint top = max_tag;
             for (int i = 0; i < nlocal; ++i)
@@ -707,13 +709,14 @@ int collheat_events_conduction(void *handle, const char *fix_id, int window)
     return 0;
 }
 
-// The heat [J] heat/gran's sources put into this rank's atoms since the last call (0 without heat/gran).
-double collheat_events_source_heat(void *handle)
+// What heat/gran added to this rank's atoms' m c Temp since the last call [J]: out[0] from its
+// sources, out[1] from its conduction (0 without heat/gran).
+void collheat_events_heat_gran_heat(void *handle, double *out)
 {
     Recorder *rec = static_cast<Recorder *>(handle);
-    const double q = rec->source_heat;
-    rec->source_heat = 0.0;
-    return q;
+    out[0] = rec->source_heat;
+    out[1] = rec->flux_heat;
+    rec->source_heat = rec->flux_heat = 0.0;
 }
 
 // Flux histories handed over and waiting (HEAD + window doubles each); with `all`, first hand

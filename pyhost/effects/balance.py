@@ -26,7 +26,7 @@ class EnergyBalance(Effect):
     when last seen; ``C``: m c [J/K] of the atoms last seen, in their order."""
 
     TOTALS = dict(inserted=0, departed=0, energy_in=0.0, energy_out=0.0, energy_set_by_script=0.0,
-                  energy_mass_change=0.0, heat_from_sources=0.0)
+                  energy_mass_change=0.0, heat_from_sources=0.0, heat_from_script_walls=0.0)
 
     def __init__(self, loop):
         super().__init__(loop)
@@ -168,11 +168,14 @@ class EnergyBalance(Effect):
                               f".heat_capacity {scene[bad[0]]:g} J/(kg K): give both the same value")
 
     def flush(self) -> None:
-        """Its total up to date (a checkpoint, the end): the heat the script's heat/gran sources
-        put in since the last flush, which the contact event recorder sums at every step."""
+        """Its totals up to date (a checkpoint, the end): what the script's fix heat/gran added
+        since the last flush from its sources and from its walls with a temperature, which the
+        contact event recorder sums at every step."""
         events = self.loop.dem.events
         if events is not None and events.window:
-            self.loop.totals["heat_from_sources"] += events.source_heat()
+            sources, walls = events.heat_gran_heat()
+            self.loop.totals["heat_from_sources"] += sources
+            self.loop.totals["heat_from_script_walls"] += walls
 
     def state(self) -> tuple[dict, dict]:
         atoms = self.loop.dem.atoms(True)
@@ -191,8 +194,8 @@ class EnergyBalance(Effect):
 
     def finish(self, summary: dict, status: str) -> None:
         """The energy balance: the residual of sum(m c T) now against the start, what the walls
-        and the script's heat sources gave, what came in and went out, what the script set and
-        what convection moved [J], relative to all that came in."""
+        (the host's and heat/gran's) and the script's heat sources gave, what came in and went
+        out, what the script set and what convection moved [J], relative to all that came in."""
         atoms = self.loop.dem.atoms(True)
         try:
             self.track(atoms)
@@ -204,10 +207,10 @@ class EnergyBalance(Effect):
         CT = float(np.sum(self.C * atoms.T))
         t = self.loop.totals
         self.came_in = (self.CT0 + t["energy_in"] + abs(t["energy_set_by_script"]) + abs(t["energy_mass_change"])
-                        + abs(t["heat_from_sources"]))
+                        + abs(t["heat_from_sources"]) + abs(t["heat_from_script_walls"]))
         self.residual = (CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]
                          - t["energy_set_by_script"] - t["energy_mass_change"] - t["heat_convected"]
-                         - t["heat_from_sources"])   # J
+                         - t["heat_from_sources"] - t["heat_from_script_walls"])   # J
         error = self.residual / max(self.came_in, 1e-300)       # relative to all that came in
         summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=error)
         if status == "completed" and not abs(error) <= TOLERANCE:

@@ -67,7 +67,7 @@ _DECLARATIONS = {
     "collheat_events_restitution": (None, [_vp, _int, _c.POINTER(_c.c_int64), _dp, _dp]),
     "collheat_events_forget": (None, [_vp, _int, _c.POINTER(_c.c_int64)]),
     "collheat_events_meshes_by_history": (_int, [_vp]),
-    "collheat_events_source_heat": (_c.c_double, [_vp]),
+    "collheat_events_heat_gran_heat": (None, [_vp, _dp]),
 }
 IMPOSED, MOVED = 1, 2      # the flags column
 HEAD = 4
@@ -108,11 +108,14 @@ class ContactEvents:
             raw = raw[:h.collheat_events_appeared(self.handle, raw.ctypes.data_as(_dp), n)]
         return raw[:, 0].astype(np.int64), raw[:, 1], raw[:, 2].astype(np.int64)
 
-    def source_heat(self) -> float:
-        """The heat [J] the script's heat/gran sources (per-atom heatSource [W]) put into the
-        particles since the last call, summed at every step as heat/gran integrates it (0
-        without heat/gran)."""
-        return self.lmp.helper.collheat_events_source_heat(self.handle)
+    def heat_gran_heat(self) -> tuple[float, float]:
+        """What the script's fix heat/gran added to the particles' m c T since the last call,
+        summed at every step as it integrates [J]: (from its sources, per-atom heatSource [W];
+        from its conduction, whose pair terms cancel: what its walls with a temperature
+        conducted in). (0, 0) without heat/gran."""
+        out = (_c.c_double * 2)()
+        self.lmp.helper.collheat_events_heat_gran_heat(self.handle, out)
+        return out[0], out[1]
 
     def restitution(self, keys, speed, normal) -> None:
         """Separation speeds [m/s] to impose on open contacts (``pyhost.collisions.contact_keys``)
@@ -217,7 +220,7 @@ class ContactEvents:
 
 
 GATHERED = {"take", "histories", "appeared", "primitives", "meshes", "waiting", "open_count", "totals",
-            "source_heat"}
+            "heat_gran_heat"}
 """What each rank answers to rank 0 (the others' recorders change only their own state)."""
 
 
@@ -293,8 +296,9 @@ class RankEvents:
     def sync(self) -> None:
         self._all("sync")
 
-    def source_heat(self) -> float:
-        return float(sum(self._all("source_heat")))       # (in rank order)
+    def heat_gran_heat(self) -> tuple[float, float]:
+        parts = self._all("heat_gran_heat")                # (summed in rank order)
+        return float(sum(p[0] for p in parts)), float(sum(p[1] for p in parts))
 
     def restitution(self, keys, speed, normal) -> None:
         self._all("restitution", np.asarray(keys), np.asarray(speed), np.asarray(normal))

@@ -116,6 +116,30 @@ def test_debian_heat_source_tutorial_closes_its_balance_with_the_sources_heat(tm
     assert abs(summary["energy_balance_error"]) < 1e-12
 
 
+@pytest.mark.skipif(not TUTORIAL.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
+def test_heat_gran_wall_with_a_temperature_enters_the_balance(tmp_path):
+    """heatTransfer_1 with its floor at 1000 K for heat/gran ('zplane 0.0 temperature 1000.',
+    LIGGGHTS' own wall conduction): the heat its walls conduct in is a term of the balance
+    (heat_from_script_walls, the net of heat/gran's flux summed at every step, its pair
+    terms cancelling), positive, and the balance closes. Without it the run failed (exit 3)
+    with the balance 4080 J off over 0.55 s."""
+    case = tmp_path / "heatTransfer_1"
+    shutil.copytree(TUTORIAL, case)
+    script = case / "in.heatGran"
+    text = script.read_text()
+    floor = next(line for line in text.splitlines() if line.startswith("fix zwalls1"))
+    script.write_text(text.replace(floor, floor.rstrip() + " temperature 1000."))
+    (case / "case.toml").write_text('[dem]\nscript = "in.heatGran"\n[effects]\ncontact_heat = "A"\n' + STEEL
+                                    + "[time]\ntest_end = 0.52\n[output]\nvtk = false\npictures = false\n")
+    r, summary = run(case, "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    print(f"heat_from_script_walls {summary['heat_from_script_walls']:.6g} J, "
+          f"balance {summary['energy_balance_error']:.3g}")
+    assert summary["heat_from_script_walls"] > 100.0          # J: the floor heats the 300 K bed
+    assert summary["heat_from_walls"] == 0.0                  # (the host's own walls: none in the scene)
+    assert abs(summary["energy_balance_error"]) < 1e-12
+
+
 @pytest.mark.skipif(not SOURCES.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
 def test_heat_gran_script_with_sources_restarts_bit_for_bit(tmp_path):
     """heatTransfer_2 (fix heat/gran conducting, its sources on) stopped by SIGTERM at 0.5625 s,
