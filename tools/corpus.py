@@ -342,6 +342,8 @@ def main(argv=None) -> int:
         if r.returncode:
             tail = (r.stderr.strip().splitlines() or ["(no message)"])[-1]
             print(f"{first}  FAILED: {tail} (log: {copy / 'host.log'})")
+        elif not checks:                    # a smoke run (--test): its exit code and time only
+            print(f"{first}  ran")
         for k, c in enumerate(checks):
             print(f"{first if k == 0 else '':<32}  {c}")
     return 1 if failed else 0

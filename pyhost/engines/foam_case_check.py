@@ -9,7 +9,7 @@ whole; the mesh's patches (constant/polyMesh/boundary, else system/blockMeshDict
 ``boundary`` or old-style ``patches``) each have an entry in 0/U and 0/p (0/T with the gas
 energy) by name, group or quoted regular expression; blocks and faces name existing
 vertices; with ``ranks`` > 1, system/decomposeParDict cuts the mesh into that many
-subdomains.
+subdomains; no fvOptions entry is of a type only CFDEM's solvers have.
 """
 from __future__ import annotations
 
@@ -151,6 +151,24 @@ def check_decomposition(folder: Path, file: str, ranks: int) -> None:
                              f"not numberOfSubdomains {ranks}")
 
 
+CFDEM_FV_OPTIONS = {"meanSupVelocityForce": "OpenFOAM's meanVelocityForce drives the mean interstitial "
+                                            "velocity instead (Ubar divided by the fluid fraction)"}
+"""fvOptions types of CFDEMcoupling's own, which OpenFOAM v1912 (and so collheatFoam) lacks,
+with what a user can write instead."""
+
+
+def check_fv_options(folder: Path, file: str) -> None:
+    """An fvOptions entry (system/ or constant/) of a type that only CFDEM's solvers have."""
+    for rel in ("system/fvOptions", "constant/fvOptions"):
+        if not (folder / rel).is_file():
+            continue
+        for name, entry in _read(folder, rel, file).items():
+            kind = entry.get("type") if isinstance(entry, dict) else None
+            if kind in CFDEM_FV_OPTIONS:
+                raise SceneError(f"{file}: fluid.case: {folder / rel}: {name}: type {kind} is CFDEMcoupling's "
+                                 f"own fvOption, which OpenFOAM v1912 does not have: {CFDEM_FV_OPTIONS[kind]}")
+
+
 def check_case(folder: Path, file: str, ranks: int, energy: bool) -> None:
     """All the checks of the module doc (the files' presence is checked by the caller)."""
     props = _read(folder, "constant/transportProperties", file)
@@ -162,5 +180,6 @@ def check_case(folder: Path, file: str, ranks: int, energy: bool) -> None:
         raise SceneError(f"{where}: rho: must be a number, the gas density in kg/m^3 (e.g. 'rho 1.2;'), "
                          f"got {props['rho']!r}")
     check_fields(folder, file, ("U", "p", "T") if energy else ("U", "p"))
+    check_fv_options(folder, file)
     if ranks > 1:
         check_decomposition(folder, file, ranks)
