@@ -380,9 +380,9 @@ struct Recorder {
         return false;
     }
 
-    // What heat/gran's transport equation adds to this rank's atoms' m c Temp at this step [J]:
-    // from the sources (to ``source``) and from the conduction flux (to ``flux``), summed over
-    // the atoms it integrates, as it integrates them (its group, nevery, capacity test).
+    // What heat/gran's transport equation adds to this rank's atoms' m c Temp at this step [J],
+    // added to source_sum (its sources) and flux_sum (its conduction flux): over the atoms it
+    // integrates, as it integrates them (its group, nevery, capacity test).
     void heat_gran_now(bigint step, double &source_sum, double &flux_sum)
     {
         const FixScalarTransportEquation *ste = conduction->fix_ste;

@@ -139,7 +139,7 @@ class Dem:
         return n
 
     def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
-                then: list[Command] = ()) -> list[str]:
+                then=()) -> list[str]:
         """What the host adds before the first run: the Temp property (if no fix heat/gran or
         property/atom Temp made it), the contact event recorder's fix and the fluid force;
         then the script's commands ``then`` (its reset_timestep right before the first run:

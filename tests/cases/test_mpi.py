@@ -319,9 +319,9 @@ def test_fluidized_bed_moves_heat_on_each_rank_at_its_exchanges(tmp_path):
 
 def test_heat_sources_on_two_ranks_sum_as_serially(tmp_path):
     """Debian's heatTransfer_2 (heat/gran's per-atom heat sources) on two ranks: each rank's
-    recorder sums the heat its own atoms' sources put in, and rank 0 adds them up: the same
-    heat_from_sources as the serial run's (to round-off; its atoms are summed in another
-    order), and the balance closes."""
+    recorder sums the heat its own atoms' sources put in, and rank 0 adds them up:
+    heat_from_sources equals LIGGGHTS' own count of the atoms given a source times their power
+    and time, to 1e-9 as serially, and the balance closes."""
     from test_user_scripts import SOURCES, heat_sources_case, source_heat_expected
     if not SOURCES.is_dir():
         pytest.skip("liggghts-doc is installed by tools/setup_engines.sh")

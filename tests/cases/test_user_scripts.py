@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import glass_toml
 
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
@@ -181,10 +182,7 @@ def test_debian_restart_with_reset_timestep_before_its_first_run_runs_unchanged(
                            text=True, timeout=300)
     assert first.returncode == 0 and (case / "post" / "liggghts.restart").exists(), first.stdout[-2000:]
     (case / "case.toml").write_text('[dem]\nscript = "in.insert_stream_reset_timestep"\n[effects]\ncontact_heat = "A"\n'
-                                    "[materials.glass]\ntypes = [1]\ntemperature = 300.0\ndensity = 2500.0\n"
-                                    "youngs_modulus = 63e9\npoisson_ratio = 0.25\nyield_stress = 500e6\n"
-                                    "heat_capacity = 840.0\nconductivity = 1.0\n"
-                                    "[time]\ntest_end = 0.03\n[output]\nvtk = false\npictures = false\n")
+                                    + glass_toml() + "[time]\ntest_end = 0.03\n[output]\nvtk = false\npictures = false\n")
     r, summary = run(case, "--test")
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     assert "reset_timestep: LIGGGHTS takes no new fix between" in r.stdout
