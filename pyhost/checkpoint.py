@@ -16,7 +16,8 @@ coupling loop calls :func:`write` at the end of a step. It writes OUT/.checkpoin
 - ``fluid/`` (scenes with a fluid): the solver's fields at this time, written with 17 digits
   (``FluidSolver.save``: the time folder, or each rank's, and the host's last exchange);
 - ``manifest.json`` last: the scene file's SHA-256, the code version (SHA-256 of pyhost/ and
-  plugins/ sources), step, time, the run's end, and the SHA-256 of each file above;
+  plugins/ sources), step, time, the run's end and its ``--extend``, the SHA-256 of each file
+  above, and ``complete`` once the run ended there (``mark_complete``);
 
 then renames it to OUT/checkpoint (the previous one is moved aside first and removed after),
 so a failed or interrupted write never destroys the last good checkpoint.
@@ -90,6 +91,7 @@ def write(coupling) -> Path:
     files = sorted(str(p.relative_to(new)) for p in new.rglob("*") if p.is_file())
     manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
                     code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
+                    extend=coupling.extend,
                     files={name: _sha256(new / name) for name in files},
                     inputs={str(f): _sha256(Path(f)) for f in coupling.inputs})
     write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
@@ -103,6 +105,15 @@ def write(coupling) -> Path:
     print(f"checkpoint at t = {coupling.t:.6g} s (step {dem.step}): {final}, {size / 1e6:.3g} MB, "
           f"{time.perf_counter() - start:.2f} s", flush=True)
     return final
+
+
+def mark_complete(out: Path) -> None:
+    """The checkpoint in OUT/checkpoint, written at the last step of a completed run, marked so
+    (``complete`` in its manifest): a restart from it needs ``--extend``."""
+    path = Path(out) / FOLDER / "manifest.json"
+    manifest = json.loads(path.read_text())
+    manifest["complete"] = True
+    write_atomic(path, json.dumps(manifest, indent=1))
 
 
 def _put_forces(dem, ids, f, torque) -> None:
@@ -121,10 +132,11 @@ def restore_forces(dem, state: dict) -> None:
     _put_forces(dem, state["ids"], state["f"], state["torque"])
 
 
-def load(out: Path, scene) -> dict:
+def load(out: Path, scene, extend: float = 0.0) -> dict:
     """The checkpoint in OUT/checkpoint checked against this scene and this code: its host
-    state (values and arrays in one dict) and ``restart``, the path of LIGGGHTS' restart
-    file. UserError (exit 2) saying why if there is none, it belongs to another case or
+    state (values and arrays in one dict), ``restart``, the path of LIGGGHTS' restart file,
+    and ``extend``, the checkpoint's run's own ``--extend`` [s], which ``extend`` (this run's)
+    may not be below. UserError (exit 2) saying why if there is none, it belongs to another case or
     another code version, or it is damaged; nothing is written. (Every scene restarts; a
     script's commands that a restart cannot replay are refused by ``pyhost.script.replay``.)"""
     folder = Path(out) / FOLDER
@@ -147,9 +159,13 @@ def load(out: Path, scene) -> dict:
     if manifest.get("code_version") != code_version():
         raise UserError(f"--restart: {folder} was written by another code version ({str(manifest.get('code_version'))[:12]}"
                         f", this is {code_version()[:12]}: SHA-256 of pyhost/ and plugins/); restart it with that code")
-    if manifest.get("end") != scene.time.end:
+    extended = float(manifest.get("extend", 0.0))
+    if extend < extended:
+        raise UserError(f"--restart: {folder} is of a run given --extend {extended:g}: give at least that")
+    end = scene.time.end + extended if extended and not scene.scripted else scene.time.end
+    if manifest.get("end") != end:
         raise UserError(f"--restart: {folder} is of a run to t = {manifest.get('end')} s, this one goes to "
-                        f"{scene.time.end} s (--test given to one of them only?)")
+                        f"{end} s (--test given to one of them only?)")
     needed = set(FILES) | ({f"{FLUID}/host.npz"} if scene.effects.fluid else set())
     for name, sha in (manifest.get("inputs") or {}).items():
         if not Path(name).is_file() or _sha256(Path(name)) != sha:
@@ -172,7 +188,11 @@ def load(out: Path, scene) -> dict:
         check_logs(out, state["logs"])
     except (OSError, ValueError) as exc:
         raise UserError(f"--restart: {exc}") from None
+    if manifest.get("complete") and extend <= extended:
+        raise UserError(f"--restart: the run in {out} is complete (t = {manifest.get('time'):.6g} s): nothing to go "
+                        f"on with; --extend SECONDS{f' (above {extended:g})' if extended else ''} runs it longer")
     state["restart"] = folder / RESTART
+    state["extend"] = extended
     state["fluid"] = folder / FLUID if scene.effects.fluid else None
     print(f"restart from {folder}: t = {manifest['time']:.6g} s (step {manifest['step']})")
     return state

@@ -136,6 +136,7 @@ class Coupling:
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
         self.command, self.run_left = -1, 0  # the script's run under way (its index) and its steps to go
         self.inputs = ()                     # the script's files (a restart checks them)
+        self.extend = 0.0                    # run --extend [s] (a checkpoint keeps it)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
         self.resumed = resume is not None    # the next advance continues the checkpoint's run
         self.checkpoint_step = -1            # the step of the last checkpoint written
@@ -321,13 +322,17 @@ class Coupling:
 
 
 def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end: float | None = None,
-              max_time: float | None = None, driven: float | None = None, progress_every: float = 5.0,
-              log=print, **particles) -> dict:
+              max_time: float | None = None, driven: float | None = None, extend: float = 0.0,
+              progress_every: float = 5.0, log=print, **particles) -> dict:
     """Run a script's commands on ``dem``; each ``run N`` is N coupled steps (steps beyond
     ``max_time`` [s] of coupled time, for smoke runs, are cut). ``driven`` [s]: how long the
     script's last ``run`` lasts when it asks for 0 steps (a CFD-DEM script whose coupling
-    drives the run, as CFDEM's end in ``run 0``). ``walls_of(dem)`` gives the HostWalls once
-    the script's walls exist; ``particles``: type_material, known and resume of ``Coupling``.
+    drives the run, as CFDEM's end in ``run 0``); in a CFDEM script (``fix couple/cfd``) the
+    last run's own steps come first, as CFDEM runs them before its coupling. ``extend`` [s]: how
+    much longer than written the script's last run goes on (``run --extend``, a restart's; a box
+    scene's end comes extended). With ``output.checkpoint`` a completed run ends in a
+    checkpoint, from which ``--extend`` goes on. ``walls_of(dem)`` gives the HostWalls once the
+    script's walls exist; ``particles``: type_material, known and resume of ``Coupling``.
     Returns the summary, also written when a step fails; a script whose runs simulate no step
     at all is refused (ScriptError) rather than ending as done."""
     coupling = None
@@ -345,6 +350,8 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
         setup = replay(commands, restart_from, resume["restart"])
         commands, replayed = setup + commands[restart_from:], len(setup)
     last_run = max((k for k, c in enumerate(commands) if c.name == "run"), default=-1)
+    # CFDEM runs a script whole (its last run too: often 'run 1'), then its coupling drives the DEM
+    cfdem = any(c.name == "fix" and c.words[3:4] == ["couple/cfd"] for c in commands)
     prepared = None
 
     held = []                           # the reset_timestep commands right before the first run
@@ -390,6 +397,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                                     progress_every=progress_every, **particles)
                 if scene.scripted:           # a restart replays them: checked unchanged
                     coupling.inputs = tuple(sorted({c.file for c in commands if c.file != "(host)"}))
+                coupling.extend = extend
                 coupling.start()
             else:
                 coupling.update_walls(walls_of(dem))
@@ -403,10 +411,17 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                     n = dem.steps(run.steps, run.upto)
                 except ScriptError as exc:
                     raise ScriptError(f"{cmd.where()}: {exc}") from None
-            if n == 0 and k == last_run and driven is not None and not (restarting and k == replayed):
-                n = round(driven / dem.dt)
-                log(f"{cmd.where()}: the script ends in a run of 0 steps, which the coupling drives: "
-                    f"{driven:g} s ({n} steps; [time] end, else the fluid case's controlDict endTime)")
+            if k == last_run and driven is not None and (n == 0 or cfdem) and not (restarting and k == replayed):
+                more = round(driven / dem.dt)
+                log(f"{cmd.where()}: " + ("the script ends in a run of 0 steps, which the coupling drives" if n == 0
+                    else f"a CFDEM script (fix couple/cfd): its last run's {n} steps, then the coupling drives")
+                    + f": {driven:g} s ({more} steps; [time] end, else the fluid case's controlDict endTime)")
+                n += more
+            if k == last_run and scene.scripted and extend:
+                more = round((extend - resume["extend"] if restarting and k == replayed else extend) / dem.dt)
+                n += more
+                if more:
+                    log(f"{cmd.where()}: --extend {extend:g}: {more} steps more than the case asks")
             if max_time is not None:
                 n = min(n, round(max_time / dem.dt) - coupling.steps)
             if n > 0:
@@ -419,6 +434,11 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             raise ScriptError(f"{scene.path}: the script's runs simulate no step (its last is "
                               f"{commands[last_run].where()}: '{commands[last_run].text}'); give the steps in "
                               f"the script" + (", or the coupled time as [time] end" if fluid is not None else ""))
+        if coupling is not None and scene.output.checkpoint:    # a completed run ends in a checkpoint, marked
+            if coupling.checkpoint_step != dem.step:             # so: --extend goes on from there
+                coupling.flush_events()
+                checkpoint.write(coupling)
+            checkpoint.mark_complete(out)
     except BaseException as exc:          # keep what was computed: summary of the run so far
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
                 and coupling.checkpoint_step != dem.step:   # (not twice at one step)

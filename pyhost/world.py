@@ -30,6 +30,30 @@ def _case_copy_filter(target: Path):
     return ignore
 
 
+def _set_aside_writes(folder: Path, restart: Path | None) -> list[Path]:
+    """A restart's copy of the user's case replaces ``folder``: the time folders the solver
+    wrote there of its own (its controlDict's writeControl) up to the checkpoint's time, moved
+    aside to OUT/.fluid-earlier to go back into the new copy (those after it are written again).
+    Returns where they are."""
+    from pyhost.engines.openfoam import _is_time
+
+    if restart is None or not Path(folder).is_dir():
+        return []
+    saved = [float(p.name) for p in Path(restart).rglob("*") if p.is_dir() and _is_time(p.name)]
+    if not saved:
+        return []
+    aside = Path(folder).parent / ".fluid-earlier"
+    shutil.rmtree(aside, ignore_errors=True)
+    aside.mkdir()
+    moved = []
+    for p in sorted(Path(folder).iterdir()):
+        if p.is_dir() and _is_time(p.name) and p.name != "0" and float(p.name) <= saved[0] * (1 + 1e-9):
+            moved.append(Path(shutil.move(str(p), aside / p.name)))
+    if not moved:
+        aside.rmdir()
+    return moved
+
+
 def start_fluid(scene, folder: Path, restart: Path | None = None):
     """The scene's fluid (``restart``: a checkpoint's saved fluid to continue from): a box case (pyhost.engines.fluid_case) over the domain and the plenum below
     it, inlet at its z lo, outlet at z hi, solved by collheatFoam every time.couple_every DEM
@@ -47,8 +71,13 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
     energy = scene.effects.convection != "none"
     if f.case:                          # the user's own case, copied: the host never writes into it
         source = (scene.folder / f.case).resolve()
+        earlier = _set_aside_writes(folder, restart)
         shutil.rmtree(folder, ignore_errors=True)
         shutil.copytree(source, folder, symlinks=True, ignore=_case_copy_filter(folder))
+        for p in earlier:
+            shutil.move(str(p), folder / p.name)
+        if earlier:
+            earlier[0].parent.rmdir()
         adopt_void_fraction(folder)
         add_final_solvers(folder)
         if adopt_piso(folder):
@@ -185,13 +214,15 @@ def driven_time(scene) -> float:
 
 
 def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.0, wrap=None, wrap_fluid=None,
-             start=None, resume: dict | None = None, link=None) -> dict:
+             start=None, resume: dict | None = None, extend: float = 0.0, link=None) -> dict:
     """Run a loaded scene into ``out`` (absolute): the user's script or the generated box
     world, with the fluid if the scene has one. ``wrap(dem)`` and ``wrap_fluid(fluid)`` may
     stand in front of the engines (tests inject faults, benchmarks record with them);
     ``start``: the particles a box scene starts from (see ``box_world``); ``resume``: the state of
-    a checkpoint to continue from (``pyhost.checkpoint.load``); ``link``: the other MPI ranks'
-    LIGGGHTS (``pyhost.engines.ranks``), None when serial. Returns the summary."""
+    a checkpoint to continue from (``pyhost.checkpoint.load``); ``extend`` [s]: how much longer
+    than the scene asks a script's last run goes on (``run --extend``; a box scene comes with its
+    end extended); ``link``: the other MPI ranks' LIGGGHTS (``pyhost.engines.ranks``), None when
+    serial. Returns the summary."""
     from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
     from pyhost.loop import run_scene
@@ -200,6 +231,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     effects = scene.effects_summary()
     driven = driven_time(scene) if scene.scripted and effects["fluid_solver"] else None
     max_time = (scene.time.test_end or (driven / 10 if driven else None)) if (test and scene.scripted) else None
+    if max_time is not None:            # a smoke run extended: its cut as much later
+        max_time += extend
     if scene.scripted:
         script, particles = scene.folder / scene.dem.script, user_script(scene)
         variables = dict(scene.dem.variables, **(scene.dem.test_variables if test else {}))
@@ -222,7 +255,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         try:
             return run_scene(scene, wrap(dem) if wrap else dem, commands, out, max_time=max_time,
                              fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
-                             end=None if scene.scripted else scene.time.end, driven=driven,
+                             end=None if scene.scripted else scene.time.end, driven=driven, extend=extend,
                              progress_every=progress_every,
                              **particles)
         finally:

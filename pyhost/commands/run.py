@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -19,6 +20,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace the run already in the output folder")
     p.add_argument("--restart", action="store_true", help="continue the run in the output folder from its "
                    "checkpoint (output.checkpoint), appending to its output")
+    p.add_argument("--extend", type=float, default=0.0, metavar="SECONDS",
+                   help="with --restart: the run goes on SECONDS of simulated time longer than its case asks "
+                   "(a box scene's time.end, a script's last run), e.g. a finished run from its last checkpoint")
 
 
 def resolved(scene) -> dict:
@@ -54,6 +58,7 @@ def run(args) -> int:
 
 
 def run_case(args, link) -> int:
+    from pyhost.exitcodes import UserError
     from pyhost.outdir import prepare_output, write_atomic
     from pyhost.scene import load_scene
     from pyhost.world import simulate
@@ -64,14 +69,20 @@ def run_case(args, link) -> int:
         scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=end))
     effects = scene.effects_summary()
     out = (args.out or args.case / "output").resolve()
-    resume = None
+    resume, extend = None, args.extend
+    if not (math.isfinite(extend) and extend >= 0):
+        raise UserError(f"--extend: simulated seconds >= 0, got {extend:g}")
+    if extend and not args.restart:
+        raise UserError("--extend continues a run from its checkpoint: give it with --restart (a new run: "
+                        "time.end or the script's runs in the case)")
     if args.restart:
         from pyhost.checkpoint import load
-        from pyhost.cli import UserError
 
         if args.overwrite:
             raise UserError("--restart continues the run in the output folder, --overwrite replaces it: give one")
-        resume = load(out, scene)
+        resume = load(out, scene, extend)
+        if extend and not scene.scripted:
+            scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=scene.time.end + extend))
     else:
         prepare_output(out, args.overwrite)
     print("scene:", json.dumps(resolved(scene), indent=1, default=str))
@@ -81,7 +92,7 @@ def run_case(args, link) -> int:
         print(f"MPI: LIGGGHTS on {link.size} ranks; the host on rank 0")
     pictures = painter(out) if scene.output.pictures else None   # own process, warming up meanwhile
     try:
-        summary = simulate(scene, out, test=args.test, resume=resume, link=link)
+        summary = simulate(scene, out, test=args.test, resume=resume, extend=extend, link=link)
     except BaseException:
         if pictures is not None:      # no pictures of a failed run
             pictures.kill()

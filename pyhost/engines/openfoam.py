@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import fcntl
 import functools
+import math
 import os
 import select
 import shutil
@@ -268,9 +269,18 @@ class FluidSolver:
         folder.mkdir(parents=True)
         for d, old in zip(self._time_folders(), before):
             new = [p for p in d.iterdir() if p.name not in old and p.is_dir() and _is_time(p.name)]
-            if len(new) != 1:
-                raise FluidError(f"the solver's write at t = {t:g} s left {len(new)} new time folders in {d}")
-            shutil.move(str(new[0]), folder / d.relative_to(self.case) / new[0].name)
+            if len(new) == 1:
+                shutil.move(str(new[0]), folder / d.relative_to(self.case) / new[0].name)
+                continue
+            # none new: the case's own writeControl wrote this time at this step (its times count from
+            # the start, a restart's too), and the write above wrote it again with 17 digits: copied,
+            # the case keeps its own write
+            same = [p for p in d.iterdir() if not new and p.is_dir() and _is_time(p.name)
+                    and math.isclose(float(p.name), t, rel_tol=1e-6, abs_tol=1e-12)]
+            if len(same) != 1:
+                raise FluidError(f"the solver's write at t = {t:g} s left {len(new)} new time folders in {d}"
+                                 + ("" if new else f" and {len(same)} of that time"))
+            shutil.copytree(same[0], folder / d.relative_to(self.case) / same[0].name)
         np.savez(folder / "host.npz", alpha=self._alpha, ksl=self._ksl, us=self._us, cell=self.cell,
                  slip=self.slip, boundary_heat=self.boundary_heat)
         return t

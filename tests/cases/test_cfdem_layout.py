@@ -3,6 +3,7 @@ settlingTestMPI): case.toml inside the OpenFOAM folder (``case = "."``), the DEM
 ../DEM ending in ``run 0`` that the coupling drives, rho in 0/rho, pressure zeroGradient at
 the walls, no [materials].dem table (the script sets the DEM values). One sphere settles
 at the Di Felice terminal speed."""
+import json
 import math
 import subprocess
 import sys
@@ -191,3 +192,62 @@ def test_cfdem_layout_stopped_and_restarted_is_the_run_never_stopped(tmp_path):
     after = velocities(marked)
     after = after[after[:, 0] > 0.051 + 1e-9]
     assert np.array_equal(velocities(cfd), after)
+
+
+def cfdem_run1_case(root: Path, test_end: float) -> Path:
+    """The layout with CFDEM's own coupling fixes and the script ending in ``run 1`` (as
+    ErgunTestMPI_restart's and ErgunTestMPI_cgs's), the solver writing every 0.01 s of its own
+    (controlDict), checkpoints every 0.01 s; --test runs ``test_end`` s."""
+    cfd = cfdem_case(root, time=f"test_end = {test_end}\n")
+    script = cfd.parent / "DEM" / "in.liggghts_run"
+    text = script.read_text()
+    script.write_text(text.replace("fix         integr all nve/sphere\nrun     0\nrun     0 upto\n",
+                                   "fix         cfd all couple/cfd couple_every 100 mpi\n"
+                                   "fix         cfd2 all couple/cfd/force/implicit\n"
+                                   "fix         integr all nve/sphere\nrun     1\n"))
+    assert "run     1\n" in script.read_text()
+    control = FoamFile(cfd / "system" / "controlDict")
+    control.update({"writeControl": "adjustableRunTime", "writeInterval": 0.01})
+    (cfd / "case.toml").write_text((cfd / "case.toml").read_text() + "\n[output]\ncheckpoint = 0.01\n")
+    return cfd
+
+
+def test_cfdem_script_ending_in_run_1_is_driven_and_extends(tmp_path):
+    """CFDEM runs a script whole, its closing ``run 1`` too, then drives the DEM for the
+    controlDict's time: the host did the 1 step and ended with exit 0 (ErgunTestMPI_restart's
+    fluid never moved). Now the run is the script's step, then the coupled time (--test: its
+    0.01 s, 1000 steps). The finished run, extended by --restart --extend 0.01, is the run of
+    0.02 s with the same checkpoints: it restarts at fluid time 0.011, so the solver's own
+    writes (every 0.01 s from its start) fall on the checkpoints' times (that stopped the
+    extended run with 'left 0 new time folders'); the first run's own writes stay in the
+    output's copy of the case (the restart's new copy deleted them). Those writes are at other times than in the
+    run never restarted (0.021 against 0.02 s), and the two differ from 0.014 s on at round-off,
+    measured 1.8e-9 relative (history.csv; byte for byte without the case's own writes):
+    1e-6 asked."""
+    cfd = cfdem_run1_case(tmp_path / "a", 0.01)
+    r = run(cfd, "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "a CFDEM script (fix couple/cfd): its last run's 1 steps, then the coupling drives" in r.stdout
+    assert json.loads((cfd / "output" / "summary.json").read_text())["steps"] == 1000
+    assert (cfd / "output" / "fluid" / "0.01" / "U").is_file()        # the solver's own write
+    r = run(cfd, "--test", "--restart", "--extend", "0.01")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    fluid = cfd / "output" / "fluid"       # the first run's writes kept (the restart copies the case anew)
+    assert (fluid / "0.01" / "U").is_file() and (fluid / "0.021" / "U").is_file()
+    assert not (cfd / "output" / ".fluid-earlier").exists()
+    assert "--extend 0.01: 1000 steps more than the case asks" in r.stdout
+    longer = cfdem_run1_case(tmp_path / "b", 0.02)
+    r = run(longer, "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+
+    def results(case):
+        out = case / "output"
+        rows = np.genfromtxt(out / "history.csv", delimiter=",", names=True)
+        return rows, json.loads((out / "summary.json").read_text()), sorted(p.name for p in (out / "vtk").iterdir())
+
+    (got, got_summary, got_vtk), (want, want_summary, want_vtk) = results(cfd), results(longer)
+    assert got.dtype.names == want.dtype.names and len(got) == len(want) == 21 and got_vtk == want_vtk
+    for name in got.dtype.names:
+        np.testing.assert_allclose(got[name], want[name], rtol=1e-6, atol=0, equal_nan=True, err_msg=name)
+    assert got_summary["steps"] == want_summary["steps"] == 2000
+    assert got_summary["time"] == want_summary["time"]

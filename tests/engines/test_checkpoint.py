@@ -238,6 +238,39 @@ def test_restart_and_overwrite_together_are_refused(stopped, capsys):
     assert "give one" in refused(capsys, "run", case_dir, "--out", out, "--restart", "--overwrite")
 
 
+def test_extend_needs_restart_and_a_time(two, tmp_path, capsys):
+    folder, _ = two
+    assert "give it with --restart" in refused(capsys, "run", folder, "--out", tmp_path / "o", "--extend", "1e-3")
+    assert "simulated seconds >= 0" in refused(capsys, "run", folder, "--out", tmp_path / "o", "--restart",
+                                               "--extend", "-1e-3")
+
+
+def test_finished_run_extended_is_the_longer_run(tmp_path, capsys):
+    """A run that completed (two-particles --test to 1.5 ms, a checkpoint every 0.5 ms: the
+    last at its end, marked complete) is refused a plain --restart (exit 2, nothing changed:
+    there is nothing to go on with), then goes on with --restart --extend 0.5e-3 to 2 ms: byte
+    for byte the case run to 2 ms at once with the same checkpoints (collisions, history, VTK;
+    summary values equal). A restart of the extended run needs --extend again."""
+    folder, longer = case(tmp_path, "two-particles", 5e-4), case(tmp_path / "longer", "two-particles", 5e-4)
+    out = tmp_path / "out"
+    r = pyhost("run", folder, "--test", "--out", out)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "checkpoint at t = 0.0015 s (step 7500)" in r.stdout
+    before = {p: p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+    assert "is complete (t = 0.0015 s)" in refused(capsys, "run", folder, "--test", "--out", out, "--restart")
+    assert {p: p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()} == before
+    r = pyhost("run", folder, "--test", "--out", out, "--restart", "--extend", "5e-4")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "restart from" in r.stdout and "checkpoint at t = 0.002 s (step 10000)" in r.stdout
+    r = pyhost("run", longer, "--out", tmp_path / "whole")      # time.end = 2 ms
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert outputs(out) == outputs(tmp_path / "whole")
+    assert summary(out) == summary(tmp_path / "whole")
+    assert summary(out)["time"] == pytest.approx(2e-3) and summary(out)["collisions"] == 1
+    assert "given --extend 0.0005: give at least that" in refused(capsys, "run", folder, "--test", "--out", out,
+                                                                  "--restart")
+
+
 # -- a user's script: its set-up replayed with the checkpoint's state in place of its box ------------
 
 def silo(tmp: Path, checkpoint: float | None = None) -> Path:
@@ -302,6 +335,30 @@ def test_script_stopped_while_pouring_restarts_bit_for_bit(tmp_path):
     stopped, _ = silo_restart_is_the_marked_run(tmp_path, 6003, checkpoint=0.030025, every=0.030025)
     assert stopped.count("checkpoint at t = 0.030025 s (step 6005)") == 1
     assert summary(tmp_path / "out")["inserted"] == 900
+
+
+def test_finished_script_extended_is_its_longer_last_run(tmp_path):
+    """silo-heat --test (16000 steps, a checkpoint every 8000: the last at its end) extended by
+    --restart --extend 0.005: its last run (the shaking) goes on 1000 steps more, byte for byte
+    the script whose last run is 1000 steps longer (collisions, history, VTK, summary and the
+    script's own last dump)."""
+    folder, longer = silo(tmp_path, checkpoint=0.04), silo(tmp_path / "longer", checkpoint=0.04)
+    toml = longer / "case.toml"
+    text = toml.read_text()
+    assert "n_shake = 2000 }" in text and "test_end = 0.08 " in text
+    toml.write_text(text.replace("n_shake = 2000 }", "n_shake = 3000 }").replace("test_end = 0.08 ", "test_end = 0.085"))
+    out = tmp_path / "out"
+    r = pyhost("run", folder, "--test", "--out", out)
+    assert r.returncode == 0, r.stderr[-2000:]
+    r = pyhost("run", folder, "--test", "--out", out, "--restart", "--extend", "0.005")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "in.liggghts:102: --extend 0.005: 1000 steps more than the case asks" in r.stdout
+    r = pyhost("run", longer, "--test", "--out", tmp_path / "whole")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert outputs(out) == outputs(tmp_path / "whole")
+    assert summary(out) == summary(tmp_path / "whole") and summary(out)["steps"] == 17000
+    last = "post/particles_17000.dump"
+    assert (folder / last).read_bytes() == (longer / last).read_bytes()
 
 
 def test_restart_of_an_edited_script_is_refused(tmp_path, capsys):
