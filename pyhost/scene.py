@@ -43,6 +43,7 @@ Example::
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import tomllib
@@ -201,6 +202,7 @@ def load_scene(path) -> Scene:
         raise SceneError(f"{file}: effects.convection: needs the gas (effects.fluid = true)")
     if fluid is not None and fluid.case:
         _user_fluid_case(fluid, path, file, effects.convection != "none")
+        fluid, time = _cfdem_settings(fluid, time, dem, data, path, file)
     elif effects.fluid and scripted:
         raise SceneError(f"{file}: fluid.case: a script scene needs its OpenFOAM case (the host generates "
                          "a fluid only for the box world)")
@@ -254,6 +256,52 @@ def _user_fluid_case(fluid, path, file, energy: bool):
                 "temperature", "inlet_temperature"):
         if getattr(fluid, key) != getattr(default, key):
             raise SceneError(f"{file}: fluid.{key}: comes from the OpenFOAM case {fluid.case!r}, not from the scene")
+
+
+def _cfdem_settings(fluid, time, dem, data, path, file):
+    """A CFDEM case says its drag law and void fraction model in constant/couplingProperties,
+    and its script how often it couples (``fix ... couple/cfd couple_every N``): taken where the
+    scene does not give fluid.drag, fluid.void_fraction or time.couple_every; a scene value that
+    disagrees, or a model the host does not have with no scene value to choose one, is refused.
+    Returns (fluid, time)."""
+    from pyhost.engines.fluid_case import CFDEM_DRAG, CFDEM_VOID_FRACTION, coupling_properties
+
+    folder = path.resolve().parent / fluid.case
+    where = folder / "constant" / "couplingProperties"
+    has = {"drag": ("forceModels", CFDEM_DRAG), "void_fraction": ("voidFractionModel", CFDEM_VOID_FRACTION)}
+    taken = {}
+    for key, (theirs, ours) in coupling_properties(folder).items():
+        entry, known = has[key]
+        given = key in data["fluid"]
+        if given and ours is not None and getattr(fluid, key) != ours:
+            raise SceneError(f"{file}: fluid.{key}: {getattr(fluid, key)!r}, but {where} {entry} has {theirs} "
+                             f"({ours!r}): remove fluid.{key} to take the case's, or make them agree")
+        if not given and ours is None:
+            raise SceneError(f"{file}: fluid.{key}: {where} {entry} has {theirs}, which the host does not have "
+                             f"(it has {', '.join(f'{a} as {b!r}' for a, b in known.items())}): give fluid.{key} "
+                             "to choose")
+        if not given:
+            taken[key] = ours
+    if dem.script:
+        every = _script_couple_every(path.resolve().parent / dem.script)
+        if every is not None:
+            number, line = every
+            if "couple_every" in data.get("time", {}) and time.couple_every != number:
+                raise SceneError(f"{file}: time.couple_every: {time.couple_every}, but {line} couples every "
+                                 f"{number} DEM steps (fix couple/cfd): remove time.couple_every to take the "
+                                 "script's, or make them agree")
+            time = dataclasses.replace(time, couple_every=number)
+    return dataclasses.replace(fluid, **taken), time
+
+
+def _script_couple_every(script: Path) -> tuple[int, str] | None:
+    """``couple_every N`` of a CFDEM script's ``fix ID GROUP couple/cfd`` (the script's own text,
+    not its includes) and where it is, or None."""
+    for k, line in enumerate(script.read_text(errors="replace").splitlines(), 1):
+        m = re.match(r"\s*fix\s+\S+\s+\S+\s+couple/cfd\b.*?\bcouple_every\s+(\d+)\b", line.split("#")[0])
+        if m:
+            return int(m.group(1)), f"{script}:{k}"
+    return None
 
 
 def _types(materials, walls, file):

@@ -148,14 +148,17 @@ class Fluid:
                                              "inlet_velocity: piecewise linear, held after the last")
     plenum: float = spec(">=0", 0.0, "particle-free fluid layer below the box [m]: the box's z lo "
                                       "wall is then a distributor, and the inlet sees no particles")
-    drag: str = spec("in:" + ",".join(sorted(DRAG_LAWS)), "gidaspow", "drag law (plugins.drag)")
+    drag: str = spec("in:" + ",".join(sorted(DRAG_LAWS)), "gidaspow",
+                     "drag law (plugins.drag); a CFDEM case's couplingProperties forceModels gives it "
+                     "when this key is absent (KochHillDrag, DiFeliceDrag, GidaspowDrag)")
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
     sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")
     alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]")
     void_fraction: str = spec("in:centre,divided", "centre",
                               "how a particle's volume and drag go to the fluid cells: all to the cell of its "
                               "centre, or divided over the cells it overlaps (CFDEM's divided model; for cells "
-                              "less than about 3 particle diameters wide)")
+                              "less than about 3 particle diameters wide); a CFDEM case's couplingProperties "
+                              "voidFractionModel gives it when this key is absent")
     conductivity: float = spec(">0", 0.026, "gas thermal conductivity [W/(m K)] (with effects.convection)")
     heat_capacity: float = spec(">0", 1005.0, "gas specific heat capacity [J/(kg K)] (with effects.convection)")
     temperature: float = spec(">0", 293.15, "initial gas temperature [K] (with effects.convection)")
@@ -199,7 +202,8 @@ class Time:
     sample_every: int = spec(">0", 1, "DEM steps between harvests of the contact events with restitution "
                                       "feedback: a contact shorter than this gets its separation speed at the "
                                       "harvest, late (restitution_late in summary.json)")
-    couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges")
+    couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges; a script's fix couple/cfd "
+                                       "couple_every (CFDEM's) gives it when this key is absent")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
 
 

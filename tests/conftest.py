@@ -168,3 +168,30 @@ simulate = r.simulate
 r.simulate = lambda *a, **k: simulate(*a, wrap=Stopping, **k)
 sys.exit(main(sys.argv[3:]))
 """
+
+
+def cfdem_case_toml(fluid: str = "", time: str = "", dem: str = "") -> str:
+    """The case.toml of a CFDEM layout (in CFD/, the script in ../DEM/in.liggghts_run): a
+    settlingTestMPI-like bead of 3000 kg/m^3; ``fluid``, ``time`` and ``dem`` are lines added to
+    [fluid], [time] and the material's table."""
+    return f"""[dem]
+script = "../DEM/in.liggghts_run"
+
+[effects]
+fluid = true
+
+[fluid]
+case = "."
+{fluid}
+[time]
+{time}
+[materials.beads]
+types = [1]
+density = 3000.0
+youngs_modulus = 63e9
+poisson_ratio = 0.25
+yield_stress = 500e6
+heat_capacity = 840.0
+conductivity = 1.0
+{dem}
+"""

@@ -209,6 +209,32 @@ def adopt_void_fraction(case: str | Path) -> bool:
     return True
 
 
+CFDEM_DRAG = {"KochHillDrag": "koch_hill", "DiFeliceDrag": "difelice", "GidaspowDrag": "gidaspow"}
+"""CFDEM's drag force models (couplingProperties' forceModels) the host has, as plugins.drag names."""
+CFDEM_VOID_FRACTION = {"divided": "divided", "centre": "centre"}
+"""CFDEM's voidFractionModel values the host has, as fluid.void_fraction values."""
+
+
+def coupling_properties(case: str | Path) -> dict[str, tuple[str, str | None]]:
+    """What a CFDEM case's constant/couplingProperties says of the drag law and of how a
+    particle's volume goes to the cells: ``{"drag": (CFDEM's model, the host's name or None
+    where it has none), "void_fraction": (...)}``, for those it names; {} without the file.
+    Several drag models in forceModels are given as one joined by '+' (the host has one law)."""
+    path = Path(case) / "constant" / "couplingProperties"
+    if not path.is_file():
+        return {}
+    f = FoamFile(path)
+    found = {}
+    drags = [str(m) for m in (f.get("forceModels") or []) if str(m).endswith("Drag") and str(m) != "noDrag"]
+    if drags:
+        name = "+".join(drags)
+        found["drag"] = (name, CFDEM_DRAG.get(name))
+    model = f.get("voidFractionModel")
+    if model is not None:
+        found["void_fraction"] = (str(model), CFDEM_VOID_FRACTION.get(str(model)))
+    return found
+
+
 def adopt_piso(case: str | Path) -> bool:
     """In a copy of a user's case: CFDEM's solvers (cfdemSolverPiso, cfdemSolverPisoScalar, ...)
     and pisoFoam read their loop from fvSolution's PISO dictionary, collheatFoam from PIMPLE.

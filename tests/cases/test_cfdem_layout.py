@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import cfdem_case_toml
 from foamlib import FoamFile
 from scipy.optimize import brentq
 
@@ -52,29 +53,6 @@ run     0
 run     0 upto
 """
 
-CASE_TOML = """[dem]
-script = "../DEM/in.liggghts_run"
-
-[effects]
-fluid = true
-
-[fluid]
-case = "."
-drag = "difelice"
-
-[time]
-couple_every = 100
-{time}
-[materials.beads]
-types = [1]
-density = 3000.0
-youngs_modulus = 63e9
-poisson_ratio = 0.25
-yield_stress = 500e6
-heat_capacity = 840.0
-conductivity = 1.0
-{dem}
-"""
 
 
 def cfdem_case(root: Path, end: float = 0.1, time: str = "", dem: str = "") -> Path:
@@ -95,7 +73,8 @@ def cfdem_case(root: Path, end: float = 0.1, time: str = "", dem: str = "") -> P
     FoamFile(cfd / "system" / "controlDict")["endTime"] = end
     (dem_dir / "post").mkdir(parents=True)
     (dem_dir / "in.liggghts_run").write_text(SCRIPT.format(d=D, rho_p=RHO_P))
-    (cfd / "case.toml").write_text(CASE_TOML.format(time=time, dem=dem))
+    (cfd / "case.toml").write_text(cfdem_case_toml(fluid='drag = "difelice"\n', time="couple_every = 100\n" + time,
+                                                   dem=dem))
     return cfd
 
 

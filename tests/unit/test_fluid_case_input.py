@@ -2,6 +2,7 @@
 uniform 0/rho, else a refusal naming the file (exit 2), before any engine starts."""
 import numpy as np
 import pytest
+from conftest import cfdem_case_toml
 from foamlib import FoamFile
 
 from pyhost.engines.fluid_case import box_case, case_density
@@ -95,3 +96,70 @@ def test_a_pimple_solvers_own_pimple_stays(case):
     piso_case(case, "cfdemSolverPimple", {"nOuterCorrectors": 3, "nCorrectors": 2})
     assert not adopt_piso(case)
     assert dict(FoamFile(case / "system" / "fvSolution")["PIMPLE"]) == {"nOuterCorrectors": 3, "nCorrectors": 2}
+
+
+
+# -- a CFDEM case's own settings: couplingProperties' drag and void fraction, the script's couple_every --
+
+COUPLING = """FoamFile {{ version 2.0; format ascii; class dictionary; object couplingProperties; }}
+modelType "A";
+voidFractionModel {void};
+forceModels
+(
+    gradPForce
+    {drag}
+    Archimedes
+);
+"""
+
+
+
+def cfdem_layout(root, fluid="", time="", drag="KochHillDrag", void="divided", every=100):
+    """CFD/ (an OpenFOAM case with CFDEM's couplingProperties, case.toml in it) and DEM/ (a
+    script whose CFDEM coupling fix couples every ``every`` steps); returns case.toml."""
+    cfd = box_case(root / "CFD", lo=(0, 0, 0), hi=(1, 1, 1), cells=(1, 1, 1), boundaries=WALLS, rho=1.5, nu=1e-5)
+    (cfd / "constant" / "couplingProperties").write_text(COUPLING.format(void=void, drag=drag))
+    (root / "DEM").mkdir()
+    (root / "DEM" / "in.liggghts_run").write_text(
+        f"units si\nfix cfd all couple/cfd couple_every {every} mpi   # CFDEM's coupling\nrun 1\n")
+    (cfd / "case.toml").write_text(cfdem_case_toml(fluid=fluid, time=time))
+    return cfd / "case.toml"
+
+
+def test_a_cfdem_cases_drag_void_fraction_and_coupling_are_taken(tmp_path):
+    """Without fluid.drag, fluid.void_fraction and time.couple_every the scene takes the case's
+    KochHillDrag and divided and the script's couple_every 100 (the defaults are gidaspow,
+    centre and 50: a CFDEM user's case ran with another drag law, silently); given and equal,
+    they stand."""
+    from pyhost.scene import load_scene
+
+    scene = load_scene(cfdem_layout(tmp_path / "a"))
+    assert (scene.fluid.drag, scene.fluid.void_fraction, scene.time.couple_every) == ("koch_hill", "divided", 100)
+    scene = load_scene(cfdem_layout(tmp_path / "b", fluid='drag = "difelice"\nvoid_fraction = "centre"\n',
+                                    time="couple_every = 20\n", drag="DiFeliceDrag", void="centre", every=20))
+    assert (scene.fluid.drag, scene.fluid.void_fraction, scene.time.couple_every) == ("difelice", "centre", 20)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(fluid='drag = "gidaspow"\n'), r"fluid.drag: 'gidaspow', but .*couplingProperties forceModels has "
+                                        r"KochHillDrag \('koch_hill'\): remove fluid.drag"),
+    (dict(fluid='void_fraction = "centre"\n'), r"fluid.void_fraction: 'centre', but .*voidFractionModel has divided"),
+    (dict(drag="BeetstraDrag"), r"fluid.drag: .*forceModels has BeetstraDrag, which the host does not have \(it "
+                                r"has KochHillDrag as 'koch_hill'.*give fluid.drag to choose"),
+    (dict(void="trilinear"), r"fluid.void_fraction: .*voidFractionModel has trilinear, which the host does not have"),
+    (dict(time="couple_every = 50\n"), r"time.couple_every: 50, but .*in.liggghts_run:2 couples every 100 DEM "
+                                       r"steps \(fix couple/cfd\)"),
+])
+def test_a_scene_that_disagrees_with_its_cfdem_case_is_refused(tmp_path, kwargs, message):
+    from pyhost.scene import SceneError, load_scene
+
+    with pytest.raises(SceneError, match=message):
+        load_scene(cfdem_layout(tmp_path, **kwargs))
+
+
+def test_a_model_the_host_lacks_runs_with_the_scenes_choice(tmp_path):
+    from pyhost.scene import load_scene
+
+    scene = load_scene(cfdem_layout(tmp_path, fluid='drag = "wenyu"\nvoid_fraction = "centre"\n',
+                                    drag="BeetstraDrag", void="trilinear"))
+    assert (scene.fluid.drag, scene.fluid.void_fraction) == ("wenyu", "centre")
