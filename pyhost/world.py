@@ -63,8 +63,8 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
     on the box's sides at their fixed temperature, the other walls adiabatic."""
     from foamlib import FoamFile
 
-    from pyhost.engines.fluid_case import (add_final_solvers, adopt_piso, adopt_void_fraction, box_case,
-                                           case_density)
+    from pyhost.engines.fluid_case import (add_final_solvers, adopt_mean_velocity_force, adopt_piso,
+                                           adopt_void_fraction, box_case, case_density)
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
@@ -82,6 +82,8 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
         add_final_solvers(folder)
         if adopt_piso(folder):
             print("fluid case: fvSolution's PISO settings run as collheatFoam's PIMPLE (one outer corrector)")
+        for entry in adopt_mean_velocity_force(folder):
+            print(f"fluid case: fvOptions {entry} runs as collheatFoam's collheatMeanVelocityForce")
         props = FoamFile(folder / "constant" / "transportProperties")
         rho, where = case_density(folder)
         if where.startswith("0/rho"):   # collheatFoam reads rho beside nu

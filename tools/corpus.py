@@ -219,6 +219,18 @@ def ergun_restart_checks(w: Path, out: Path) -> list[Check]:
             Check("mean pressure drop of the fluidized bed, 0.061-0.101 s [Pa]", float(np.mean(drops)), weight, 0.10)]
 
 
+def periodic_checks(w: Path, out: Path) -> list[Check]:
+    """periodicChannel's own check (its octave/checkVolFlow.m): the gas flow through the
+    periodic inlet at the last step against its meanSupVelocityForce's Ubar (10 m/s,
+    superficial) times the section (0.1 x 0.1 m), and none through the walls; read from the
+    case's own function objects (volFlow_inlet, volFlow_wall: the sum of phi)."""
+    def last(name):
+        rows = np.loadtxt(next((out / "fluid" / "postProcessing" / name).rglob("surfaceFieldValue.dat")), ndmin=2)
+        return float(rows[-1, 1])
+    return [Check("gas flow through the periodic inlet [m^3/s]", abs(last("volFlow_inlet")), 10.0 * 0.1 * 0.1, 0.01),
+            Check("gas flow through the walls [m^3/s]", last("volFlow_wall"), 0.0, 1e-9, relative=False)]
+
+
 def liggghts_checks(w: Path, out: Path) -> list[Check]:
     return [balance_check(out)]
 
@@ -248,12 +260,13 @@ conductivity = 1.0
 """
 
 
-def cfdem_scene(density: float, *, cp: float = 840.0, T: float = 300.0, effects: str = "") -> str:
+def cfdem_scene(density: float, *, cp: float = 840.0, T: float = 300.0, effects: str = "",
+                script: str = "in.liggghts_run") -> str:
     """The case.toml a user writes into a CFDEM tutorial's CFD/ folder (docs/tutorials.md): the
     drag law and void fraction model come from its couplingProperties, the coupling interval
     from its script's fix couple/cfd."""
     return f"""[dem]
-script = "../DEM/in.liggghts_run"   # run from CFD/, as CFDEM runs LIGGGHTS
+script = "../DEM/{script}"   # run from CFD/, as CFDEM runs LIGGGHTS
 
 [effects]
 fluid = true
@@ -286,6 +299,11 @@ TUTORIALS = [
                       copy_file("CFD/constant/couplingProperties_run", "CFD/constant/couplingProperties")],
              native_first=("DEM", "in.liggghts_init"), then=("--restart", "--extend", "0.05"),
              checks=ergun_restart_checks),
+    Tutorial("periodicChannel", "cfdem", "tutorials/cfdemSolverPiso/periodicChannel", "CFD",
+             cfdem_scene(2000.0, script="in.liggghts_resume"),
+             changes=[mkdir("DEM", "post", "restart"),
+                      drop_line("DEM/in.liggghts_resume", "processors", "it asks for 4 ranks; the host runs on 1")],
+             native_first=("DEM", "in.liggghts_init"), checks=periodic_checks),
     Tutorial("packedBedTemp", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\nconvection = "gunn"\n'),
              changes=[mkdir("DEM", "post", "restart"),

@@ -254,6 +254,38 @@ def adopt_piso(case: str | Path) -> bool:
     return True
 
 
+MEAN_VELOCITY_FORCES = {"meanVelocityForce": False, "meanSupVelocityForce": True}
+"""fvOptions types that drive a mean velocity, and whether the mean is superficial (CFDEM's)."""
+
+
+def adopt_mean_velocity_force(case: str | Path) -> list[str]:
+    """In a copy of a user's case: an fvOptions entry of OpenFOAM's meanVelocityForce or
+    CFDEM's meanSupVelocityForce becomes collheatFoam's collheatMeanVelocityForce (the same
+    control for its face-momentum form, with ``superficial`` true for CFDEM's), its
+    ``<type>Coeffs`` entries moved up. v1912's own meanVelocityForce misjudges the flow's
+    response in collheatFoam and overshoots (plugins/openfoam/collheatFoam/
+    collheatMeanVelocityForce.H). Returns the entries changed, as 'NAME (TYPE)'."""
+    changed = []
+    for rel in ("system/fvOptions", "constant/fvOptions"):
+        path = Path(case) / rel
+        if not path.is_file():
+            continue
+        f = FoamFile(path)
+        for name in list(f.keys()):
+            entry = f[name] if name is not None else None
+            if not hasattr(entry, "get") or str(entry.get("type")) not in MEAN_VELOCITY_FORCES:
+                continue
+            kind = str(entry["type"])
+            new = {k: v for k, v in dict(entry).items() if k != kind + "Coeffs"}
+            new.update({k: v for k, v in dict(entry.get(kind + "Coeffs", {})).items()
+                        if k not in ("twoPhase", "coupled", "voidfractionField", "alphaField", "alphaMin")})
+            new["type"] = "collheatMeanVelocityForce"
+            new["superficial"] = MEAN_VELOCITY_FORCES[kind]
+            f[name] = new
+            changed.append(f"{name} ({kind})")
+    return changed
+
+
 def add_final_solvers(case: str | Path) -> list[str]:
     """In a copy of a user's case: OpenFOAM v1912 looks up 'XFinal' solver settings for the
     last corrector of every field X it solves; cases written for older versions (CFDEM's

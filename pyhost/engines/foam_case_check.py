@@ -151,22 +151,20 @@ def check_decomposition(folder: Path, file: str, ranks: int) -> None:
                              f"not numberOfSubdomains {ranks}")
 
 
-CFDEM_FV_OPTIONS = {"meanSupVelocityForce": "OpenFOAM's meanVelocityForce drives the mean interstitial "
-                                            "velocity instead (Ubar divided by the fluid fraction)"}
-"""fvOptions types of CFDEMcoupling's own, which OpenFOAM v1912 (and so collheatFoam) lacks,
-with what a user can write instead."""
-
-
 def check_fv_options(folder: Path, file: str) -> None:
-    """An fvOptions entry (system/ or constant/) of a type that only CFDEM's solvers have."""
+    """An fvOptions entry (system/ or constant/) of CFDEM's meanSupVelocityForce for two fluid
+    phases (twoPhase true: an alphaField the host does not have). The mean velocity forces
+    themselves run as collheatFoam's own (``fluid_case.adopt_mean_velocity_force``)."""
     for rel in ("system/fvOptions", "constant/fvOptions"):
         if not (folder / rel).is_file():
             continue
         for name, entry in _read(folder, rel, file).items():
             kind = entry.get("type") if isinstance(entry, dict) else None
-            if kind in CFDEM_FV_OPTIONS:
-                raise SceneError(f"{file}: fluid.case: {folder / rel}: {name}: type {kind} is CFDEMcoupling's "
-                                 f"own fvOption, which OpenFOAM v1912 does not have: {CFDEM_FV_OPTIONS[kind]}")
+            coeffs = entry.get(f"{kind}Coeffs", {}) if isinstance(entry, dict) else {}
+            if kind == "meanSupVelocityForce" and str(coeffs.get("twoPhase", "false")).lower() in ("true", "yes", "on", "1"):
+                raise SceneError(f"{file}: fluid.case: {folder / rel}: {name}: meanSupVelocityForce with twoPhase "
+                                 "true weights the mean by a second fluid phase, which the host does not have: "
+                                 "set twoPhase false")
 
 
 def check_case(folder: Path, file: str, ranks: int, energy: bool) -> None:

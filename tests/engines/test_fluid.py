@@ -292,3 +292,81 @@ def test_fluid_restarted_from_its_saved_state_continues_bit_for_bit(tmp_path, np
     for a, b, name in zip(whole, restarted, ("force", "p", "U")):
         assert np.array_equal(a, b), f"{name}: max difference {np.abs(a - b).max():.3g}"
     assert np.abs(whole[2]).max() > 0.05           # a flow, not a fluid at rest
+
+
+MEAN_SUP = """FoamFile { version 2.0; format ascii; class dictionary; object fvOptions; }
+momentumSource
+{
+    type            meanSupVelocityForce;
+    active          yes;
+    meanSupVelocityForceCoeffs
+    {
+        selectionMode   all;
+        fields          (U);
+        Ubar            (1 0 0);
+        relaxation      0.9;
+        twoPhase        false;
+        coupled         true;
+        voidfractionField "voidfraction";
+    }
+}
+"""
+
+FLOW_RATE = {"type": "surfaceFieldValue", "libs": ["libfieldFunctionObjects.so"], "writeControl": "timeStep",
+             "writeInterval": 1, "log": False, "writeFields": False, "regionType": "patch", "name": "xlo",
+             "operation": "sum", "fields": ["alphaPhi"]}
+
+
+def periodic_channel(path):
+    """A duct 0.4 x 0.1 x 0.1 m, periodic along x (cyclic xlo/xhi), walls around, gas of
+    10 kg/m^3; CFDEM's meanSupVelocityForce driving its superficial mean to 1 m/s (as
+    CFDEM's periodicChannel); a surfaceFieldValue of the superficial flux through xlo."""
+    from foamlib import FoamFile
+
+    case = box_case(path, lo=(0, 0, 0), hi=(0.4, 0.1, 0.1), cells=(8, 4, 4), boundaries=WALLS, rho=10.0,
+                    nu=1.5e-5, gravity=(0, 0, 0), dt=1e-3, rel_tol=0.0)
+    mesh = FoamFile(case / "system" / "blockMeshDict")
+    mesh["boundary"] = [(name, dict(entry, type="cyclic", neighbourPatch={"xlo": "xhi", "xhi": "xlo"}[name])
+                         if name in ("xlo", "xhi") else entry) for name, entry in mesh["boundary"]]
+    for field in (case / "0").iterdir():
+        f = FoamFile(field)
+        for name in ("xlo", "xhi"):
+            f["boundaryField"][name] = {"type": "cyclic"}
+    (case / "system" / "fvOptions").write_text(MEAN_SUP)
+    FoamFile(case / "system" / "controlDict")["functions"] = {"flowRate": FLOW_RATE}
+    return case
+
+
+def test_periodic_channel_driven_by_cfdems_mean_velocity_force(tmp_path):
+    """CFDEM's periodicChannel drives its flow with meanSupVelocityForce (CFDEM's own; v1912
+    lacks it, and v1912's meanVelocityForce misjudges collheatFoam's response: the tutorial
+    driven to 10 m/s swung to 11.9 m/s and was at 11.25 m/s at its 10th step). The host's
+    copy runs it as collheatMeanVelocityForce: with 300 resting particles of 8 mm in half the
+    duct the superficial mean velocity is 1 m/s within 1e-4 after 30 steps, the flux through
+    the periodic face is that
+    mean times the section (the case's own function object, which the host-driven solver now
+    executes at every step), and no gas crosses the walls."""
+    from foamlib import FoamFile
+
+    from pyhost.engines.fluid_case import adopt_mean_velocity_force
+
+    case = periodic_channel(tmp_path / "channel")
+    assert adopt_mean_velocity_force(case) == ["momentumSource (meanSupVelocityForce)"]
+    rng = np.random.default_rng(7)
+    x = rng.uniform((0.01, 0.01, 0.01), (0.2, 0.09, 0.09), (300, 3))     # one half of the duct
+    with FluidSolver(case, drag="difelice") as fluid:
+        for _ in range(30):
+            fluid.couple(x, np.zeros((300, 3)), 8e-3, 1e-3)
+        t = fluid.write()
+        volumes = fluid.cell_volumes
+    alpha = np.asarray(FoamFile(case / f"{t:g}" / "alpha")["internalField"])
+    u = np.asarray(FoamFile(case / f"{t:g}" / "U")["internalField"])
+    assert alpha.min() < 0.99                            # the particles are in the flow
+    superficial = float(np.sum(alpha * u[:, 0] * volumes) / volumes.sum())
+    interstitial = float(np.sum(u[:, 0] * volumes) / volumes.sum())
+    print(f"superficial mean {superficial:.6f} m/s, interstitial {interstitial:.6f} m/s")
+    assert superficial == pytest.approx(1.0, abs=1e-4)
+    assert interstitial > superficial + 1e-3             # the superficial mean is the one driven
+    rows = np.loadtxt(next((case / "postProcessing" / "flowRate").rglob("surfaceFieldValue.dat")), ndmin=2)
+    assert len(rows) >= 30                               # a row at every step
+    assert abs(rows[-1, 1]) == pytest.approx(superficial * 0.1 * 0.1, rel=2e-2)

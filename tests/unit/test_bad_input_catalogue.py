@@ -278,10 +278,11 @@ FLUID_CASES = {   # id: (changes of the valid user case, words the one-line mess
     "block names a missing vertex": ([foam_text("system/blockMeshDict", BLOCKS.replace("VERTEX", "8"))],
                                      ["system/blockMeshDict: blocks", "from 0 to 7"]),
     "blockMeshDict without blocks": ([foam_edit("system/blockMeshDict", "blocks")], ["blockMeshDict: blocks: missing"]),
-    "CFDEM's own fvOption": ([foam_text("system/fvOptions", "FoamFile { version 2.0; format ascii; class dictionary; "
-                                        "object fvOptions; }\nmomentumSource { type meanSupVelocityForce; "
-                                        "active yes; }\n")],
-                             ["system/fvOptions: momentumSource: type meanSupVelocityForce is CFDEMcoupling's own"]),
+    "CFDEM's fvOption for two phases": ([foam_text("system/fvOptions", "FoamFile { version 2.0; format ascii; "
+                                                  "class dictionary; object fvOptions; }\nmomentumSource { type "
+                                                  "meanSupVelocityForce; active yes; meanSupVelocityForceCoeffs "
+                                                  "{ twoPhase true; } }\n")],
+                                       ["system/fvOptions: momentumSource: meanSupVelocityForce with twoPhase true"]),
     "subdomains differ from ranks": ([foam_scene(ranks=2)],
                                      ["decomposeParDict: numberOfSubdomains: 1, but fluid.ranks = 2"]),
     "simple split differs from ranks": ([foam_scene(ranks=2), foam_edit("system/decomposeParDict",

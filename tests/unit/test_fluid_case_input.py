@@ -163,3 +163,25 @@ def test_a_model_the_host_lacks_runs_with_the_scenes_choice(tmp_path):
     scene = load_scene(cfdem_layout(tmp_path, fluid='drag = "wenyu"\nvoid_fraction = "centre"\n',
                                     drag="BeetstraDrag", void="trilinear"))
     assert (scene.fluid.drag, scene.fluid.void_fraction) == ("wenyu", "centre")
+
+
+def test_mean_velocity_forces_run_as_collheatfoams(case):
+    """CFDEM's meanSupVelocityForce (its Coeffs sub-dictionary, its own keys) and OpenFOAM's
+    meanVelocityForce become collheatMeanVelocityForce in the copy, superficial for CFDEM's;
+    other fvOptions are left as they are."""
+    from pyhost.engines.fluid_case import adopt_mean_velocity_force
+
+    (case / "system" / "fvOptions").write_text(
+        "FoamFile { version 2.0; format ascii; class dictionary; object fvOptions; }\n"
+        "drive { type meanSupVelocityForce; active yes; meanSupVelocityForceCoeffs { selectionMode all; "
+        "fields (U); Ubar (10 0 0); relaxation 0.9; twoPhase false; coupled true; voidfractionField voidfraction; } }\n"
+        "plain { type meanVelocityForce; selectionMode all; fields (U); Ubar (0 1 0); }\n"
+        "heat { type scalarSemiImplicitSource; selectionMode all; }\n")
+    assert adopt_mean_velocity_force(case) == ["drive (meanSupVelocityForce)", "plain (meanVelocityForce)"]
+    f = FoamFile(case / "system" / "fvOptions")
+    drive, plain = dict(f["drive"]), dict(f["plain"])
+    assert drive["type"] == plain["type"] == "collheatMeanVelocityForce"
+    assert drive["superficial"] is True and plain["superficial"] is False
+    assert list(drive["Ubar"]) == [10, 0, 0] and drive["relaxation"] == 0.9 and drive["fields"] == ["U"]
+    assert not {"meanSupVelocityForceCoeffs", "twoPhase", "coupled", "voidfractionField"} & set(drive)
+    assert f["heat"]["type"] == "scalarSemiImplicitSource"
