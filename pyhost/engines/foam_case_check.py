@@ -161,7 +161,8 @@ def check_fv_options(folder: Path, file: str) -> None:
         for name, entry in _read(folder, rel, file).items():
             kind = entry.get("type") if isinstance(entry, dict) else None
             coeffs = entry.get(f"{kind}Coeffs", {}) if isinstance(entry, dict) else {}
-            if kind == "meanSupVelocityForce" and str(coeffs.get("twoPhase", "false")).lower() in ("true", "yes", "on", "1"):
+            two_phase = str(coeffs.get("twoPhase", "false")).lower() in ("true", "yes", "on", "1")
+            if kind == "meanSupVelocityForce" and two_phase:
                 raise SceneError(f"{file}: fluid.case: {folder / rel}: {name}: meanSupVelocityForce with twoPhase "
                                  "true weights the mean by a second fluid phase, which the host does not have: "
                                  "set twoPhase false")
