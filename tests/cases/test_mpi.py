@@ -360,6 +360,29 @@ def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
     assert_continued(serial, whole)
 
 
+def test_finished_two_rank_run_extended_is_the_longer_run(tmp_path):
+    """hot-cold-box --test (10 ms) on two ranks with a checkpoint every 5 ms ends in one at its
+    end; --restart --extend 0.005 on two ranks gives byte for byte (collisions.csv,
+    history.csv; summary values) the two-rank run of 15 ms with the same checkpoints."""
+    def box(name, test_end):
+        case = tmp_path / name
+        shutil.copytree(CASES / "hot-cold-box", case, ignore=shutil.ignore_patterns("output", "log.*"))
+        text = (case / "case.toml").read_text()
+        assert "test_end = 0.01\n" in text
+        (case / "case.toml").write_text(text.replace("test_end = 0.01\n", f"test_end = {test_end}\n")
+                                        + "checkpoint = 0.005\npictures = false\n")
+        return case
+
+    case, longer = box("box", 0.01), box("longer", 0.015)
+    first = run(case, tmp_path / "out", 2, "--test")
+    assert first["status"] == "completed" and first["time"] == pytest.approx(0.01)
+    extended = run(case, tmp_path / "out", 2, "--test", "--restart", "--extend", "0.005")
+    whole = run(longer, tmp_path / "whole", 2, "--test")
+    assert extended == whole and whole["time"] == pytest.approx(0.015)
+    for name in ("collisions.csv", "history.csv"):
+        assert (tmp_path / "out" / name).read_bytes() == (tmp_path / "whole" / name).read_bytes(), name
+
+
 def assert_continued(restarted, whole):
     """A restart on another number of ranks: the run's end, energy to rounding, collisions and
     heat within the gas's chaos between rank counts."""
