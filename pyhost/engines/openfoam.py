@@ -275,8 +275,8 @@ class FluidSolver:
             # none new: the case's own writeControl wrote this time at this step (its times count from
             # the start, a restart's too), and the write above wrote it again with 17 digits: copied,
             # the case keeps its own write
-            same = [p for p in d.iterdir() if not new and p.is_dir() and _is_time(p.name)
-                    and math.isclose(float(p.name), t, rel_tol=1e-6, abs_tol=1e-12)]
+            same = [] if new else [p for p in d.iterdir() if p.is_dir() and _is_time(p.name)
+                                   and math.isclose(float(p.name), t, rel_tol=1e-6, abs_tol=1e-12)]
             if len(same) != 1:
                 raise FluidError(f"the solver's write at t = {t:g} s left {len(new)} new time folders in {d}"
                                  + ("" if new else f" and {len(same)} of that time"))
