@@ -18,6 +18,7 @@
 #include "fix_external.h"
 #include "update.h"
 #include "output.h"
+#include "atom.h"
 
 using namespace LAMMPS_NS;
 
@@ -235,6 +236,19 @@ double *collheat_fix_external_force(void *ptr, const char *id)
 
 // LIGGGHTS' unit style now ("si", "cgs", "lj", ...: a units command, a restart file's, or the default).
 const char *collheat_unit_style(void *ptr) { return static_cast<LAMMPS *>(ptr)->update->unit_style; }
+
+// LIGGGHTS' atom style now (the script's atom_style, a restart file's, or the default atomic),
+// and whether its atoms are plain spheres: a radius and a mass per atom (atom_style granular or
+// sphere, alone or in a hybrid) and no shape of another kind (superquadric, ellipsoid, line,
+// tri, body). SPH particles (atom_style sph) have neither radius nor per-atom mass.
+const char *collheat_atom_style(void *ptr) { return static_cast<LAMMPS *>(ptr)->atom->atom_style; }
+
+int collheat_sphere_atoms(void *ptr)
+{
+    const Atom *a = static_cast<LAMMPS *>(ptr)->atom;
+    return a->sphere_flag && a->radius_flag && a->rmass_flag && !a->superquadric_flag && !a->ellipsoid_flag
+           && !a->line_flag && !a->tri_flag && !a->body_flag;
+}
 
 // The interval [steps] of the script's most frequent dump with a fixed interval; 0 if none.
 int collheat_dump_every(void *ptr)

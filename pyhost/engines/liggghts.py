@@ -71,6 +71,8 @@ _HELPER_DECLARATIONS = {
     "collheat_keep_mesh_bins": (_int, [_vp]),
     "collheat_dump_every": (_int, [_vp]),
     "collheat_unit_style": (_cp, [_vp]),
+    "collheat_atom_style": (_cp, [_vp]),
+    "collheat_sphere_atoms": (_int, [_vp]),
 }
 
 # Per-atom arrays: name -> (ctype, columns; 0 for a vector).
@@ -345,8 +347,12 @@ class Liggghts:
             text = trial.read_text(errors="replace") if trial.exists() else ""
             trial.unlink(missing_ok=True)
             errors = [ln for ln in text.splitlines() if ln.startswith("ERROR")]
-            message = errors[-1] if errors else (text.strip().splitlines() or ["no message"])[-1]
-            raise LiggghtsError(f"LIGGGHTS refused '{what}': {message}")
+            code = os.waitstatus_to_exitcode(status)
+            if errors or code > 0:
+                message = errors[-1] if errors else (text.strip().splitlines() or ["no message"])[-1]
+                raise LiggghtsError(f"LIGGGHTS refused '{what}': {message}")
+            raise LiggghtsError(f"LIGGGHTS crashed on '{what}' (signal {signal.Signals(-code).name}, no error message: "
+                                "a fault of LIGGGHTS or of the host's helper on this input; please report it)")
         trial.unlink(missing_ok=True)
 
     @staticmethod
@@ -409,6 +415,12 @@ class Liggghts:
         """LIGGGHTS' unit style now: the script's ``units``, a restart file's, or LIGGGHTS'
         default (lj)."""
         return self.helper.collheat_unit_style(self.ptr).decode()
+
+    def atom_style(self) -> tuple[str, bool]:
+        """LIGGGHTS' atom style now (the script's ``atom_style``, a restart file's, or the
+        default atomic) and whether its atoms are plain spheres (radius and mass per atom, no
+        other shape)."""
+        return self.helper.collheat_atom_style(self.ptr).decode(), bool(self.helper.collheat_sphere_atoms(self.ptr))
 
     def dump_every(self) -> int:
         """The interval [steps] of the most frequent dump defined now with a fixed interval

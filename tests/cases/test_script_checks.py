@@ -126,6 +126,50 @@ def test_a_script_without_units_si_is_refused_at_its_first_run(tmp_path):
     assert s is None
 
 
+SPH = """atom_style sph
+atom_modify map array sort 0 0
+communicate single vel yes
+boundary f f f
+newton off
+units si
+lattice sc 0.01
+region box block 0 0.1 0 0.1 0 0.1 units box
+create_box 1 box
+region fill block 0.01 0.05 0.01 0.05 0.01 0.05 units box
+create_atoms 1 region fill
+mass 1 0.001
+neighbor 0.003 bin
+fix m1 all property/global speedOfSound peratomtype 20.
+fix m2 all property/global sl peratomtype 0.012
+fix m3 all property/global artViscAlpha peratomtype 4.1666e-3
+fix m4 all property/global artViscBeta peratomtype 0.
+fix m5 all property/global artViscEta scalar 1.44e-6
+fix m6 all property/global tensCorrEpsilon scalar 0.2
+fix m7 all property/global tensCorrDeltaP peratomtype 0.01
+pair_style sph/artVisc/tensCorr cubicspline 0.012 artVisc tensCorr
+pair_coeff * *
+timestep 1e-5
+fix density all sph/density/continuity
+fix pressure all sph/pressure Tait 60000. 1000. 7.
+fix integr all nve/sph
+set group all meso_rho 1000
+set group all sphkernel cubicspline
+run 10
+"""
+
+
+def test_a_script_of_other_particles_than_spheres_is_refused_at_its_first_run(tmp_path):
+    """SPH particles (Debian's sph_1 and sph_2 tutorials: atom_style sph) have no radius: the
+    contact recorder read LIGGGHTS' null radius array and the first run's trial copy crashed
+    (SIGSEGV), reported as "LIGGGHTS refused 'run 0 post no': no message". LIGGGHTS' own atom
+    style is read at the first run: exit 2 naming it, before a step."""
+    r, s = run(tmp_path, SPH, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "in.run:29 (the first run): the script's atoms are LIGGGHTS' atom_style sph, not spheres" in r.stderr, \
+        r.stderr[-3000:]
+    assert "Segmentation fault" not in r.stdout + r.stderr and s is None
+
+
 def test_particles_at_zero_kelvin_are_refused(tmp_path):
     """No fix heat/gran and no material temperature: the particles would start at 0 K."""
     r, _ = run(tmp_path, header() + "run 100\n", toml(temperature=""))

@@ -184,6 +184,18 @@ def test_commands_tried_together_fork_once_and_a_bad_one_still_reports_its_own_e
         assert lg.step == 10
 
 
+def test_a_crash_in_the_trial_copy_is_reported_as_a_crash(tmp_path):
+    """A trial copy that dies of a signal (a fault, no ERROR line) is said to have crashed,
+    naming the signal, where it used to be "LIGGGHTS refused ...: no message". The instance
+    is unharmed and still runs."""
+    import ctypes
+    with two_spheres(tmp_path) as lg:
+        with pytest.raises(LiggghtsError, match=r"LIGGGHTS crashed on 'x' \(signal SIGSEGV, no error message"):
+            lg._tried(lambda: ctypes.string_at(0), "x")
+        lg.run(10)
+        assert lg.step == 10
+
+
 def test_error_in_a_later_chunk_returns_with_liggghts_message(tmp_path):
     """Chunks after the first are not tried in a forked copy: LIGGGHTS' error (here Error::one
     of a 'fix print' reaching an undefined variable at step 20) returns from the run as
