@@ -201,8 +201,8 @@ def load_scene(path) -> Scene:
     if effects.convection != "none" and not effects.fluid:
         raise SceneError(f"{file}: effects.convection: needs the gas (effects.fluid = true)")
     if fluid is not None and fluid.case:
+        effects, fluid, time = _cfdem_settings(effects, fluid, time, dem, data, path, file)
         _user_fluid_case(fluid, path, file, effects.convection != "none")
-        fluid, time = _cfdem_settings(fluid, time, dem, data, path, file)
     elif effects.fluid and scripted:
         raise SceneError(f"{file}: fluid.case: a script scene needs its OpenFOAM case (the host generates "
                          "a fluid only for the box world)")
@@ -258,30 +258,41 @@ def _user_fluid_case(fluid, path, file, energy: bool):
             raise SceneError(f"{file}: fluid.{key}: comes from the OpenFOAM case {fluid.case!r}, not from the scene")
 
 
-def _cfdem_settings(fluid, time, dem, data, path, file):
-    """A CFDEM case says its drag law and void fraction model in constant/couplingProperties,
-    and its script how often it couples (``fix ... couple/cfd couple_every N``): taken where the
-    scene does not give fluid.drag, fluid.void_fraction or time.couple_every; a scene value that
-    disagrees, or a model the host does not have with no scene value to choose one, is refused.
-    Returns (fluid, time)."""
-    from pyhost.engines.fluid_case import CFDEM_DRAG, CFDEM_VOID_FRACTION, coupling_properties
+def _cfdem_settings(effects, fluid, time, dem, data, path, file):
+    """A CFDEM case says its drag law, void fraction model and gas-particle heat transfer (with
+    the gas's conductivity and heat capacity) in constant/couplingProperties, and its script
+    how often it couples (``fix ... couple/cfd couple_every N``): taken where the scene does not
+    give the key (fluid.drag, fluid.void_fraction, effects.convection, fluid.conductivity,
+    fluid.heat_capacity, time.couple_every); a scene value that disagrees, or a model the host
+    does not have with no scene value to choose one, is refused. So is a case that transports
+    species (the host solves the gas temperature only). Returns (effects, fluid, time)."""
+    from pyhost.engines.fluid_case import CFDEM_KNOWN, cfdem_species, coupling_properties
 
     folder = path.resolve().parent / fluid.case
+    species = cfdem_species(folder)
+    if species:
+        names = ", ".join(sorted({name for name, _ in species}))
+        raise SceneError(f"{file}: fluid.case: the case transports species ({names}: {species[0][1]}); the host "
+                         "solves the gas flow and temperature only: remove the species from the case (and the "
+                         "script's couple/cfd/speciesConvection) to run its flow and heat")
     where = folder / "constant" / "couplingProperties"
-    has = {"drag": ("forceModels", CFDEM_DRAG), "void_fraction": ("voidFractionModel", CFDEM_VOID_FRACTION)}
-    taken = {}
-    for key, (theirs, ours) in coupling_properties(folder).items():
-        entry, known = has[key]
-        given = key in data["fluid"]
-        if given and ours is not None and getattr(fluid, key) != ours:
-            raise SceneError(f"{file}: fluid.{key}: {getattr(fluid, key)!r}, but {where} {entry} has {theirs} "
-                             f"({ours!r}): remove fluid.{key} to take the case's, or make them agree")
+    tables = {"effects": effects, "fluid": fluid}
+    taken = {"effects": {}, "fluid": {}}
+    for scene_key, (entry, theirs, ours) in coupling_properties(folder).items():
+        table, key = scene_key.split(".")
+        value = getattr(tables[table], key)
+        given = key in data.get(table, {})
+        agree = (math.isclose(value, ours, rel_tol=1e-12) if isinstance(ours, float) else value == ours)
+        if given and ours is not None and not agree:
+            raise SceneError(f"{file}: {scene_key}: {value!r}, but {where} {entry} has {theirs} ({ours!r}): remove "
+                             f"{scene_key} to take the case's, or make them agree")
         if not given and ours is None:
-            raise SceneError(f"{file}: fluid.{key}: {where} {entry} has {theirs}, which the host does not have "
-                             f"(it has {', '.join(f'{a} as {b!r}' for a, b in known.items())}): give fluid.{key} "
+            known = CFDEM_KNOWN[scene_key]
+            raise SceneError(f"{file}: {scene_key}: {where} {entry} has {theirs}, which the host does not have "
+                             f"(it has {', '.join(f'{a} as {b!r}' for a, b in known.items())}): give {scene_key} "
                              "to choose")
         if not given:
-            taken[key] = ours
+            taken[table][key] = ours
     if dem.script:
         every = _script_couple_every(path.resolve().parent / dem.script)
         if every is not None:
@@ -291,7 +302,7 @@ def _cfdem_settings(fluid, time, dem, data, path, file):
                                  f"{number} DEM steps (fix couple/cfd): remove time.couple_every to take the "
                                  "script's, or make them agree")
             time = dataclasses.replace(time, couple_every=number)
-    return dataclasses.replace(fluid, **taken), time
+    return (dataclasses.replace(effects, **taken["effects"]), dataclasses.replace(fluid, **taken["fluid"]), time)
 
 
 def _script_couple_every(script: Path) -> tuple[int, str] | None:

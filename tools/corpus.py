@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Run public tutorials nobody here wrote through the host, as a user would, and check
-their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI and packedBedTemp, and
-Debian's liggghts-doc tutorials (packing, heatTransfer_1 and _2, chute_wear, conveyor,
-meshGran, movingMeshGran, insert_stream and its restart, mesh_tet, hysteresis, cohesion,
-contactModels, hydrogel_multicontact's default).
+their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI (and its two-stage
+restart), periodicChannel and packedBedTemp (cfdemSolverPisoScalar's; cfdemSolverPisoSTM's,
+which transports a species, must be refused), and Debian's liggghts-doc tutorials (packing,
+heatTransfer_1 and _2, chute_wear, conveyor, meshGran, movingMeshGran, insert_stream and its
+restart, mesh_tet, hysteresis, cohesion, contactModels, hydrogel_multicontact's default).
 
 The tutorials are not part of this repository (their licences are theirs, and fetched
 content is never committed): point ``--cfdem`` at a CFDEMcoupling-PUBLIC checkout; Debian's
@@ -85,6 +86,7 @@ class Tutorial:
     native_first: tuple = ()          # (folder inside the copy, script) run with `liggghts -in`
     then: tuple = ()                  # the host's arguments of a second stage (--restart ...), if any
     checks: Callable | None = None    # (copy, out) -> list[Check]
+    refused: str = ""                 # an input the host must refuse: its words (exit 2)
 
 
 def mkdir(*parts):
@@ -305,11 +307,14 @@ TUTORIALS = [
                       drop_line("DEM/in.liggghts_resume", "processors", "it asks for 4 ranks; the host runs on 1")],
              native_first=("DEM", "in.liggghts_init"), checks=periodic_checks),
     Tutorial("packedBedTemp", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
-             cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\nconvection = "gunn"\n'),
+             cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),    # its LaEuScalarTemp: li_mason
              changes=[mkdir("DEM", "post", "restart"),
                       drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
                       drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks")],
              native_first=("DEM", "in.liggghts_init"), checks=packed_bed_checks),
+    Tutorial("packedBedTempSTM", "cfdem", "tutorials/cfdemSolverPisoSTM/packedBedTemp", "CFD",   # species C
+             cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),
+             refused="the case transports species (C, speciesC"),
     Tutorial("heatTransfer_1", "liggghts", "heatTransfer_1", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),
              checks=liggghts_checks),
     Tutorial("heatTransfer_2", "liggghts", "heatTransfer_2", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),
@@ -392,9 +397,15 @@ def main(argv=None) -> int:
         (copy / "host.log").write_text(log)
         # a smoke run ends before the states the checks are about (a settled speed, a time)
         checks = tut.checks(copy, out) if r.returncode == 0 and tut.checks and not args.test else []
+        first = f"{tut.name:<20} {r.returncode:>3} {wall:7.1f}"
+        if tut.refused:                     # bad input for the host: exit 2 with its reason, nothing run
+            ok = r.returncode == 2 and tut.refused in r.stderr
+            failed += not ok
+            print(f"{first}  {'refused, as it must be' if ok else 'NOT REFUSED AS EXPECTED'}: "
+                  f"{(r.stderr.strip().splitlines() or ['(no message)'])[-1]}")
+            continue
         bad = r.returncode != 0 or not all(c.ok for c in checks)
         failed += bad
-        first = f"{tut.name:<20} {r.returncode:>3} {wall:7.1f}"
         if r.returncode:
             tail = (r.stderr.strip().splitlines() or ["(no message)"])[-1]
             print(f"{first}  FAILED: {tail} (log: {copy / 'host.log'})")

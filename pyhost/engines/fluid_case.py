@@ -213,25 +213,71 @@ CFDEM_DRAG = {"KochHillDrag": "koch_hill", "DiFeliceDrag": "difelice", "Gidaspow
 """CFDEM's drag force models (couplingProperties' forceModels) the host has, as plugins.drag names."""
 CFDEM_VOID_FRACTION = {"divided": "divided", "centre": "centre"}
 """CFDEM's voidFractionModel values the host has, as fluid.void_fraction values."""
+CFDEM_NUSSELT = {"LiMason": "li_mason", "Gunn": "gunn", "Deen": "deen"}
+"""CFDEM's Nusselt correlations (LaEuScalarTemp's NuCorrelation, scalarGeneralExchange's
+switches) the host has, as plugins.convection names. CFDEM forms Re on the interstitial slip
+d |U - v| / nu, the host (and the correlations' authors) on the superficial alpha d |U - v| / nu."""
+CFDEM_KNOWN = {"fluid.drag": CFDEM_DRAG, "fluid.void_fraction": CFDEM_VOID_FRACTION,
+               "effects.convection": CFDEM_NUSSELT}
+"""The scene keys a CFDEM model name goes to, with the names the host has."""
 
 
-def coupling_properties(case: str | Path) -> dict[str, tuple[str, str | None]]:
-    """What a CFDEM case's constant/couplingProperties says of the drag law and of how a
-    particle's volume goes to the cells: ``{"drag": (CFDEM's model, the host's name or None
-    where it has none), "void_fraction": (...)}``, for those it names; {} without the file.
-    Several drag models in forceModels are given as one joined by '+' (the host has one law)."""
+def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
+    """What a CFDEM case's constant/couplingProperties says that a scene key also says, by
+    scene key: ``{"fluid.drag": (entry, CFDEM's value, the host's value or None where it has
+    none), ...}`` for the drag law (forceModels), how a particle's volume goes to the cells
+    (voidFractionModel), the gas-particle heat transfer (forceModels' LaEuScalarTemp and its
+    NuCorrelation, default LiMason; scalarGeneralExchange: useLiMason, useGeneralCorrelation,
+    else Deen) and the gas's conductivity [W/(m K)] and heat capacity [J/(kg K)] that model
+    names (lambda, Cp); {} without the file. Several drag models in forceModels are given as one
+    joined by '+' (the host has one law)."""
     path = Path(case) / "constant" / "couplingProperties"
     if not path.is_file():
         return {}
     f = FoamFile(path)
     found = {}
-    drags = [str(m) for m in (f.get("forceModels") or []) if str(m).endswith("Drag") and str(m) != "noDrag"]
+    models = [str(m) for m in (f.get("forceModels") or [])]
+    drags = [m for m in models if m.endswith("Drag") and m != "noDrag"]
     if drags:
         name = "+".join(drags)
-        found["drag"] = (name, CFDEM_DRAG.get(name))
+        found["fluid.drag"] = ("forceModels", name, CFDEM_DRAG.get(name))
     model = f.get("voidFractionModel")
     if model is not None:
-        found["void_fraction"] = (str(model), CFDEM_VOID_FRACTION.get(str(model)))
+        found["fluid.void_fraction"] = ("voidFractionModel", str(model), CFDEM_VOID_FRACTION.get(str(model)))
+    for heat in ("LaEuScalarTemp", "scalarGeneralExchange"):
+        if heat not in models:
+            continue
+        props = f.get(f"{heat}Props") or {}
+        if heat == "LaEuScalarTemp":
+            nusselt = str(props.get("NuCorrelation", "LiMason")).strip('"')
+        else:
+            nusselt = ("LiMason" if props.get("useLiMason") is True else
+                       "generalCorrelation" if props.get("useGeneralCorrelation") is True else "Deen")
+        found["effects.convection"] = ("forceModels", f"{heat} ({nusselt})", CFDEM_NUSSELT.get(nusselt))
+        for key, entry in (("fluid.conductivity", "lambda"), ("fluid.heat_capacity", "Cp")):
+            if isinstance(props.get(entry), (int, float)) and not isinstance(props.get(entry), bool):
+                found[key] = (f"{heat}Props {entry}", f"{props[entry]:g}", float(props[entry]))
+        break
+    return found
+
+
+def cfdem_species(case: str | Path) -> list[tuple[str, str]]:
+    """The species a CFDEM case transports besides T, each with where it is named: the eulerian
+    fields of constant/scalarTransportProperties other than T, and the particles' species of
+    couplingProperties' scalarGeneralExchangeProps (partSpeciesNames)."""
+    case = Path(case)
+    found = []
+    transport = case / "constant" / "scalarTransportProperties"
+    if transport.is_file():
+        f = FoamFile(transport)
+        model = str(f.get("scalarTransportModel", ""))
+        fields = (f.get(f"{model}Props") or {}).get("eulerianFields") or []
+        found += [(str(name), f"{transport} {model}Props eulerianFields") for name in fields if str(name) != "T"]
+    coupling = case / "constant" / "couplingProperties"
+    if coupling.is_file():
+        props = FoamFile(coupling).get("scalarGeneralExchangeProps") or {}
+        found += [(str(name), f"{coupling} scalarGeneralExchangeProps partSpeciesNames")
+                  for name in props.get("partSpeciesNames") or [] if str(name) != "none"]
     return found
 
 

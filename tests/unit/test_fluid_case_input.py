@@ -109,20 +109,27 @@ forceModels
     gradPForce
     {drag}
     Archimedes
+    {heat}
 );
+{props}
 """
 
 
 
-def cfdem_layout(root, fluid="", time="", drag="KochHillDrag", void="divided", every=100):
+def cfdem_layout(root, fluid="", time="", drag="KochHillDrag", void="divided", every=100, heat="", props="",
+                 effects=""):
     """CFD/ (an OpenFOAM case with CFDEM's couplingProperties, case.toml in it) and DEM/ (a
-    script whose CFDEM coupling fix couples every ``every`` steps); returns case.toml."""
-    cfd = box_case(root / "CFD", lo=(0, 0, 0), hi=(1, 1, 1), cells=(1, 1, 1), boundaries=WALLS, rho=1.5, nu=1e-5)
-    (cfd / "constant" / "couplingProperties").write_text(COUPLING.format(void=void, drag=drag))
+    script whose CFDEM coupling fix couples every ``every`` steps); returns case.toml. ``heat``:
+    a heat transfer force model, ``props``: its dictionary; ``effects``: lines of [effects]."""
+    cfd = box_case(root / "CFD", lo=(0, 0, 0), hi=(1, 1, 1), cells=(1, 1, 1), boundaries=WALLS, rho=1.5, nu=1e-5,
+                   T0=300.0)
+    (cfd / "constant" / "couplingProperties").write_text(COUPLING.format(void=void, drag=drag, heat=heat,
+                                                                         props=props))
     (root / "DEM").mkdir()
     (root / "DEM" / "in.liggghts_run").write_text(
         f"units si\nfix cfd all couple/cfd couple_every {every} mpi   # CFDEM's coupling\nrun 1\n")
-    (cfd / "case.toml").write_text(cfdem_case_toml(fluid=fluid, time=time))
+    (cfd / "case.toml").write_text(cfdem_case_toml(fluid=fluid, time=time).replace("fluid = true\n",
+                                                                                    "fluid = true\n" + effects))
     return cfd / "case.toml"
 
 
@@ -163,6 +170,65 @@ def test_a_model_the_host_lacks_runs_with_the_scenes_choice(tmp_path):
     scene = load_scene(cfdem_layout(tmp_path, fluid='drag = "wenyu"\nvoid_fraction = "centre"\n',
                                     drag="BeetstraDrag", void="trilinear"))
     assert (scene.fluid.drag, scene.fluid.void_fraction) == ("wenyu", "centre")
+
+
+LAEU = "LaEuScalarTempProps { tempFieldName \"T\"; partTempName \"Temp\"; lambda 0.0256; Cp 1007; %s }"
+GENERAL = "scalarGeneralExchangeProps { tempFieldName \"T\"; lambda 0.03; %s }"
+
+
+@pytest.mark.parametrize("heat, props, expected", [
+    ("LaEuScalarTemp", LAEU % "", ("li_mason", 0.0256, 1007.0)),              # CFDEM's default: LiMason
+    ("LaEuScalarTemp", LAEU % "NuCorrelation Gunn;", ("gunn", 0.0256, 1007.0)),
+    ("scalarGeneralExchange", GENERAL % "useLiMason true;", ("li_mason", 0.03, 1005.0)),
+    ("scalarGeneralExchange", GENERAL % "", ("deen", 0.03, 1005.0)),         # its default: Deen et al.
+])
+def test_a_cfdem_cases_heat_transfer_is_taken(tmp_path, heat, props, expected):
+    """The case's gas-particle heat transfer model (LaEuScalarTemp's NuCorrelation, CFDEM's
+    default LiMason; scalarGeneralExchange's switches, default Deen) and the gas conductivity
+    and heat capacity it names: taken without effects.convection, fluid.conductivity and
+    fluid.heat_capacity, where the run used to go without any gas-particle heat (convection
+    'none'), silently; the heat capacity the model does not name stays the scene's 1005."""
+    from pyhost.scene import load_scene
+
+    scene = load_scene(cfdem_layout(tmp_path, heat=heat, props=props))
+    assert (scene.effects.convection, scene.fluid.conductivity, scene.fluid.heat_capacity) == expected
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(effects='convection = "gunn"\n'), r"effects.convection: 'gunn', but .*couplingProperties forceModels has "
+                                             r"LaEuScalarTemp \(LiMason\) \('li_mason'\): remove effects.convection"),
+    (dict(effects='convection = "none"\n'), r"effects.convection: 'none', but .* LaEuScalarTemp \(LiMason\)"),
+    (dict(fluid="conductivity = 0.026\n"), r"fluid.conductivity: 0.026, but .*LaEuScalarTempProps lambda has 0.0256"),
+    (dict(props=GENERAL % "useGeneralCorrelation true;", heat="scalarGeneralExchange"),
+     r"effects.convection: .* has scalarGeneralExchange \(generalCorrelation\), which the host does not have \(it "
+     r"has LiMason as 'li_mason', Gunn as 'gunn', Deen as 'deen'\): give effects.convection to choose"),
+])
+def test_a_scene_that_disagrees_with_its_cfdem_cases_heat_transfer_is_refused(tmp_path, kwargs, message):
+    from pyhost.scene import SceneError, load_scene
+
+    kwargs = {"heat": "LaEuScalarTemp", "props": LAEU % "", **kwargs}
+    with pytest.raises(SceneError, match=message):
+        load_scene(cfdem_layout(tmp_path, **kwargs))
+
+
+def test_a_cfdem_case_with_species_is_refused(tmp_path):
+    """CFDEM's cfdemSolverPisoSTM/packedBedTemp transports a species C with the particles'
+    speciesC: the host solves no species, and the run ended with exit 0, C never moved."""
+    from pyhost.scene import SceneError, load_scene
+
+    toml = cfdem_layout(tmp_path, heat="scalarGeneralExchange",
+                        props=GENERAL % "useLiMason true; partSpeciesNames ( speciesC ); partSpeciesFluxNames "
+                                        "( speciesCFlux );")
+    with pytest.raises(SceneError, match=r"fluid.case: the case transports species \(speciesC: .*couplingProperties "
+                                         r"scalarGeneralExchangeProps partSpeciesNames\); the host solves the gas "
+                                         r"flow and temperature only"):
+        load_scene(toml)
+    (tmp_path / "CFD" / "constant" / "scalarTransportProperties").write_text(
+        "FoamFile { version 2.0; format ascii; class dictionary; object scalarTransportProperties; }\n"
+        "scalarTransportModel generalManual;\ngeneralManualProps { eulerianFields ( C T ); }\n")
+    with pytest.raises(SceneError, match=r"species \(C, speciesC: .*scalarTransportProperties generalManualProps "
+                                         r"eulerianFields\)"):
+        load_scene(toml)
 
 
 def test_mean_velocity_forces_run_as_collheatfoams(case):

@@ -79,7 +79,7 @@ def test_dry_isothermal_scene_builds_nothing_extra(tmp_path):
     ("yield_stress = 300e6\n", "", "materials.steel.yield_stress: missing"),
     ("[effects]", "[effects]\nfluid = true", "fluid: missing section"),
     ('contact_heat = "A"', 'contact_heat = "A"\nconvection = "wakao"',
-     "effects.convection: must be one of none, gunn, li_mason, ranz_marshall"),
+     "effects.convection: must be one of none, deen, gunn, li_mason, ranz_marshall"),
     ('contact_heat = "A"', 'contact_heat = "A"\nconvection = "gunn"', "effects.convection: needs the gas"),
     ("[domain]", "[fluid]\nconductivity = 0.0\n\n[domain]", "fluid.conductivity: must be > 0"),
     ("[domain]", "[fluid]\nheat_capacity = -5.0\n\n[domain]", "fluid.heat_capacity: must be > 0"),
