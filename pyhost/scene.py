@@ -262,8 +262,8 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
     """A CFDEM case says its drag law, void fraction model and gas-particle heat transfer (with
     the gas's conductivity and heat capacity) in constant/couplingProperties, and its script
     how often it couples (``fix ... couple/cfd couple_every N``): taken where the scene does not
-    give the key (fluid.drag, fluid.void_fraction, effects.convection, fluid.conductivity,
-    fluid.heat_capacity, time.couple_every); a scene value that disagrees, or a model the host
+    give the key (fluid.drag, fluid.void_fraction, fluid.alpha_min, effects.convection,
+    fluid.conductivity, fluid.heat_capacity, time.couple_every); a scene value that disagrees, or a model the host
     does not have with no scene value to choose one, is refused. So is a case that transports
     species (the host solves the gas temperature only). Returns (effects, fluid, time)."""
     from pyhost.engines.fluid_case import CFDEM_KNOWN, cfdem_species, coupling_properties

@@ -213,6 +213,8 @@ CFDEM_DRAG = {"KochHillDrag": "koch_hill", "DiFeliceDrag": "difelice", "Gidaspow
 """CFDEM's drag force models (couplingProperties' forceModels) the host has, as plugins.drag names."""
 CFDEM_VOID_FRACTION = {"divided": "divided", "centre": "centre"}
 """CFDEM's voidFractionModel values the host has, as fluid.void_fraction values."""
+CFDEM_ALPHA_MIN = 0.1
+"""The floor of the fluid fraction of CFDEM's divided and centre models without alphaMin."""
 CFDEM_NUSSELT = {"LiMason": "li_mason", "Gunn": "gunn", "Deen": "deen"}
 """CFDEM's Nusselt correlations (LaEuScalarTemp's NuCorrelation, scalarGeneralExchange's
 switches) the host has, as plugins.convection names. CFDEM forms Re on the interstitial slip
@@ -226,7 +228,7 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     """What a CFDEM case's constant/couplingProperties says that a scene key also says, by
     scene key: ``{"fluid.drag": (entry, CFDEM's value, the host's value or None where it has
     none), ...}`` for the drag law (forceModels), how a particle's volume goes to the cells
-    (voidFractionModel), the gas-particle heat transfer (forceModels' LaEuScalarTemp and its
+    (voidFractionModel) and the floor of the fluid fraction (its Props' alphaMin), the gas-particle heat transfer (forceModels' LaEuScalarTemp and its
     NuCorrelation, default LiMason; scalarGeneralExchange: useLiMason, useGeneralCorrelation,
     else Deen) and the gas's conductivity [W/(m K)] and heat capacity [J/(kg K)] that model
     names (lambda, Cp); {} without the file. Several drag models in forceModels are given as one
@@ -244,6 +246,10 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     model = f.get("voidFractionModel")
     if model is not None:
         found["fluid.void_fraction"] = ("voidFractionModel", str(model), CFDEM_VOID_FRACTION.get(str(model)))
+        floor = (f.get(f"{model}Props") or {}).get("alphaMin")
+        if str(model) in CFDEM_VOID_FRACTION:   # (CFDEM's divided and centre clip at alphaMin, default 0.1)
+            found["fluid.alpha_min"] = ((f"{model}Props alphaMin", f"{floor:g}", float(floor)) if floor is not None
+                                        else (f"{model}Props", "no alphaMin: CFDEM's default 0.1", CFDEM_ALPHA_MIN))
     for heat in ("LaEuScalarTemp", "scalarGeneralExchange"):
         if heat not in models:
             continue

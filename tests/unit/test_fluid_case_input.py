@@ -172,6 +172,25 @@ def test_a_model_the_host_lacks_runs_with_the_scenes_choice(tmp_path):
     assert (scene.fluid.drag, scene.fluid.void_fraction) == ("wenyu", "centre")
 
 
+def test_a_cfdem_cases_fluid_fraction_floor_is_taken(tmp_path):
+    """CFDEM's divided and centre models clip the fluid fraction at their Props' alphaMin
+    (packedBedTemp 0.4, ErgunTestMPI_restart 0.01), 0.1 without it (ErgunTestMPI): taken for
+    fluid.alpha_min, whose scene default 0.3 ran in their place, silently; a scene value that
+    differs is refused."""
+    from pyhost.scene import SceneError, load_scene
+
+    assert load_scene(cfdem_layout(tmp_path / "a")).fluid.alpha_min == 0.1
+    assert load_scene(cfdem_layout(tmp_path / "b", props="dividedProps { alphaMin 0.4; }")).fluid.alpha_min == 0.4
+    assert load_scene(cfdem_layout(tmp_path / "c", void="centre", fluid='void_fraction = "centre"\nalpha_min = 0.01\n',
+                                   props="centreProps { alphaMin 0.01; }")).fluid.alpha_min == 0.01
+    with pytest.raises(SceneError, match=r"fluid.alpha_min: 0.3, but .*couplingProperties dividedProps alphaMin has "
+                                         r"0.4 \(0.4\): remove fluid.alpha_min"):
+        load_scene(cfdem_layout(tmp_path / "d", fluid="alpha_min = 0.3\n", props="dividedProps { alphaMin 0.4; }"))
+    with pytest.raises(SceneError, match=r"fluid.alpha_min: 0.3, but .*dividedProps has no alphaMin: CFDEM's default "
+                                         r"0.1 \(0.1\)"):
+        load_scene(cfdem_layout(tmp_path / "e", fluid="alpha_min = 0.3\n"))
+
+
 LAEU = "LaEuScalarTempProps { tempFieldName \"T\"; partTempName \"Temp\"; lambda 0.0256; Cp 1007; %s }"
 GENERAL = "scalarGeneralExchangeProps { tempFieldName \"T\"; lambda 0.03; %s }"
 
