@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Run public tutorials nobody here wrote through the host, as a user would, and check
 their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI (and its two-stage
-restart), periodicChannel and packedBedTemp (cfdemSolverPisoScalar's; cfdemSolverPisoSTM's,
-which transports a species, must be refused), and Debian's liggghts-doc tutorials (packing,
+restart), periodicChannel and packedBedTemp (cfdemSolverPisoScalar's, serially and as written
+on its two ranks; cfdemSolverPisoSTM's, which transports a species, must be refused), and Debian's liggghts-doc tutorials (packing,
 heatTransfer_1 and _2, chute_wear, conveyor, meshGran, movingMeshGran, insert_stream and its
 restart, mesh_tet, hysteresis, cohesion, contactModels, hydrogel_multicontact's default).
 
@@ -26,6 +26,7 @@ import argparse
 import csv
 import json
 import math
+import os
 import re
 import shutil
 import subprocess
@@ -87,6 +88,7 @@ class Tutorial:
     then: tuple = ()                  # the host's arguments of a second stage (--restart ...), if any
     checks: Callable | None = None    # (copy, out) -> list[Check]
     refused: str = ""                 # an input the host must refuse: its words (exit 2)
+    ranks: int = 1                    # > 1: the native stage and the host under mpirun (its processors line kept)
 
 
 def mkdir(*parts):
@@ -327,6 +329,10 @@ TUTORIALS = [
                       drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
                       drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks")],
              native_first=("DEM", "in.liggghts_init"), checks=packed_bed_checks),
+    Tutorial("packedBedTemp_np2", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
+             cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),   # as it is, on its 2 ranks
+             changes=[mkdir("DEM", "post", "restart")], native_first=("DEM", "in.liggghts_init"), ranks=2,
+             checks=packed_bed_checks),
     Tutorial("packedBedTempSTM", "cfdem", "tutorials/cfdemSolverPisoSTM/packedBedTemp", "CFD",   # species C
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),
              refused="the case transports species (C, speciesC"),
@@ -372,9 +378,16 @@ def prepare(tut: Tutorial, cfdem: Path | None, work: Path) -> Path:
     return dst
 
 
-def run_native(copy: Path, folder: str, script: str) -> None:
-    r = subprocess.run(["liggghts", "-in", script, "-screen", "/dev/null"], cwd=copy / folder,
-                       capture_output=True, text=True)
+MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+
+def mpirun(ranks: int) -> list[str]:
+    return ["mpirun", "--oversubscribe", "-np", str(ranks)] if ranks > 1 else []
+
+
+def run_native(copy: Path, folder: str, script: str, ranks: int = 1) -> None:
+    r = subprocess.run(mpirun(ranks) + ["liggghts", "-in", script, "-screen", "/dev/null"], cwd=copy / folder,
+                       capture_output=True, text=True, env=MPI_ENV)
     if r.returncode:
         raise RuntimeError(f"native stage {folder}/{script} failed (rc {r.returncode}): {r.stdout[-500:]}")
 
@@ -398,15 +411,17 @@ def main(argv=None) -> int:
             continue
         copy = prepare(tut, args.cfdem, args.work)
         if tut.native_first:
-            run_native(copy, *tut.native_first)
+            run_native(copy, *tut.native_first, ranks=tut.ranks)
         case, out = copy / tut.case_dir, copy / "host-output"
-        cmd = [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(out), "--overwrite"]
+        cmd = mpirun(tut.ranks) + [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(out), "--overwrite"]
         start = time.perf_counter()
-        r = subprocess.run(cmd + (["--test"] if args.test else []), cwd=ROOT, capture_output=True, text=True)
+        r = subprocess.run(cmd + (["--test"] if args.test else []), cwd=ROOT, capture_output=True, text=True,
+                           env=MPI_ENV)
         log = r.stdout + r.stderr
         if tut.then and r.returncode == 0:                # the tutorial's second stage
             cmd = [a for a in cmd if a != "--overwrite"] + list(tut.then)
-            r = subprocess.run(cmd + (["--test"] if args.test else []), cwd=ROOT, capture_output=True, text=True)
+            r = subprocess.run(cmd + (["--test"] if args.test else []), cwd=ROOT, capture_output=True, text=True,
+                               env=MPI_ENV)
             log += r.stdout + r.stderr
         wall = time.perf_counter() - start
         (copy / "host.log").write_text(log)
