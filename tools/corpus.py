@@ -2,7 +2,8 @@
 """Run public tutorials nobody here wrote through the host, as a user would, and check
 their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI (and its two-stage
 restart), periodicChannel and packedBedTemp (cfdemSolverPisoScalar's, serially and as written
-on its two ranks; cfdemSolverPisoSTM's, which transports a species, must be refused), and Debian's liggghts-doc tutorials (packing,
+on its two ranks; cfdemSolverPisoSTM's, which transports a species, and cfdemSolverIB's
+twoSpheresGlowinskiMPI, whose particles the mesh resolves, must be refused), and Debian's liggghts-doc tutorials (packing,
 heatTransfer_1 and _2, chute_wear, conveyor, meshGran, movingMeshGran, insert_stream and its
 restart, mesh_tet, hysteresis, cohesion, contactModels, hydrogel_multicontact's default).
 
@@ -336,6 +337,8 @@ TUTORIALS = [
     Tutorial("packedBedTempSTM", "cfdem", "tutorials/cfdemSolverPisoSTM/packedBedTemp", "CFD",   # species C
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),
              refused="the case transports species (C, speciesC"),
+    Tutorial("twoSpheresGlowinskiMPI", "cfdem", "tutorials/cfdemSolverIB/twoSpheresGlowinskiMPI", "CFD",
+             cfdem_scene(1500.0), refused="the case resolves its particles on the mesh"),     # immersed boundary
     Tutorial("heatTransfer_1", "liggghts", "heatTransfer_1", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),
              checks=liggghts_checks),
     Tutorial("heatTransfer_2", "liggghts", "heatTransfer_2", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),

@@ -267,6 +267,20 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     return found
 
 
+def cfdem_resolved(case: str | Path) -> str | None:
+    """Where a CFDEM case resolves its particles on the mesh (cfdemSolverIB: voidFractionModel
+    IB or bigParticle, immersed-boundary force models such as ShirgaonkarIB), or None."""
+    path = Path(case) / "constant" / "couplingProperties"
+    if not path.is_file():
+        return None
+    f = FoamFile(path)
+    model = str(f.get("voidFractionModel", ""))
+    if model in ("IB", "bigParticle"):
+        return f"{path} voidFractionModel {model}"
+    forces = [str(m) for m in (f.get("forceModels") or []) if str(m).endswith("IB")]
+    return f"{path} forceModels {' '.join(forces)}" if forces else None
+
+
 def cfdem_species(case: str | Path) -> list[tuple[str, str]]:
     """The species a CFDEM case transports besides T, each with where it is named: the eulerian
     fields of constant/scalarTransportProperties other than T, and the particles' species of

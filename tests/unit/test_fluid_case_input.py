@@ -250,6 +250,22 @@ def test_a_cfdem_case_with_species_is_refused(tmp_path):
         load_scene(toml)
 
 
+@pytest.mark.parametrize("kwargs, where", [
+    (dict(void="IB", drag="ShirgaonkarIB"), "voidFractionModel IB"),
+    (dict(void="bigParticle", drag=""), "voidFractionModel bigParticle"),
+    (dict(drag="ShirgaonkarIB"), "forceModels ShirgaonkarIB"),
+])
+def test_a_cfdem_case_of_resolved_particles_is_refused(tmp_path, kwargs, where):
+    """cfdemSolverIB's twoSpheresGlowinskiMPI resolves its two spheres on the mesh (immersed
+    boundaries): refused as such, where the host used to advise choosing one of its own void
+    fraction models (which would have run it as unresolved particles)."""
+    from pyhost.scene import SceneError, load_scene
+
+    with pytest.raises(SceneError, match=r"fluid.case: the case resolves its particles on the mesh \(an immersed "
+                                         rf"boundary, as cfdemSolverIB: .*couplingProperties {where}\)"):
+        load_scene(cfdem_layout(tmp_path, **kwargs))
+
+
 def test_mean_velocity_forces_run_as_collheatfoams(case):
     """CFDEM's meanSupVelocityForce (its Coeffs sub-dictionary, its own keys) and OpenFOAM's
     meanVelocityForce become collheatMeanVelocityForce in the copy, superficial for CFDEM's;
