@@ -264,23 +264,15 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
     how often it couples (``fix ... couple/cfd couple_every N``): taken where the scene does not
     give the key (fluid.drag, fluid.void_fraction, fluid.alpha_min, effects.convection,
     fluid.conductivity, fluid.heat_capacity, time.couple_every); a scene value that disagrees, or a model the host
-    does not have with no scene value to choose one, is refused. So is a case that resolves its
-    particles on the mesh (cfdemSolverIB's) or transports species (the host solves the gas
-    temperature only). Returns (effects, fluid, time)."""
-    from pyhost.engines.fluid_case import CFDEM_KNOWN, cfdem_resolved, cfdem_species, coupling_properties
+    does not have with no scene value to choose one, is refused. So is a case the host cannot run
+    as written (``cfdem_unsupported``: resolved particles, species, a flow not solved). Returns
+    (effects, fluid, time)."""
+    from pyhost.engines.fluid_case import CFDEM_KNOWN, cfdem_unsupported, coupling_properties
 
     folder = path.resolve().parent / fluid.case
-    resolved = cfdem_resolved(folder)
-    if resolved:
-        raise SceneError(f"{file}: fluid.case: the case resolves its particles on the mesh (an immersed boundary, "
-                         f"as cfdemSolverIB: {resolved}); the host couples particles smaller than the cells, "
-                         "through a fluid fraction and a drag law")
-    species = cfdem_species(folder)
-    if species:
-        names = ", ".join(sorted({name for name, _ in species}))
-        raise SceneError(f"{file}: fluid.case: the case transports species ({names}: {species[0][1]}); the host "
-                         "solves the gas flow and temperature only: remove the species from the case (and the "
-                         "script's couple/cfd/speciesConvection) to run its flow and heat")
+    why = cfdem_unsupported(folder)
+    if why:
+        raise SceneError(f"{file}: fluid.case: {why}")
     where = folder / "constant" / "couplingProperties"
     tables = {"effects": effects, "fluid": fluid}
     taken = {"effects": {}, "fluid": {}}

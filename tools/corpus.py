@@ -3,7 +3,8 @@
 their physics: CFDEMcoupling-PUBLIC's settlingTestMPI, ErgunTestMPI (and its two-stage
 restart), periodicChannel and packedBedTemp (cfdemSolverPisoScalar's, serially and as written
 on its two ranks; cfdemSolverPisoSTM's, which transports a species, and cfdemSolverIB's
-twoSpheresGlowinskiMPI, whose particles the mesh resolves, must be refused), and Debian's liggghts-doc tutorials (packing,
+twoSpheresGlowinskiMPI, whose particles the mesh resolves, and voidfractionTest, whose flow is not
+solved, and ErgunTestMPI_cgs, in cgs units, must be refused), and Debian's liggghts-doc tutorials (packing,
 heatTransfer_1 and _2, chute_wear, conveyor, meshGran, movingMeshGran, insert_stream and its
 restart, mesh_tet, hysteresis, cohesion, contactModels, hydrogel_multicontact's default).
 
@@ -339,6 +340,10 @@ TUTORIALS = [
              refused="the case transports species (C, speciesC"),
     Tutorial("twoSpheresGlowinskiMPI", "cfdem", "tutorials/cfdemSolverIB/twoSpheresGlowinskiMPI", "CFD",
              cfdem_scene(1500.0), refused="the case resolves its particles on the mesh"),     # immersed boundary
+    Tutorial("voidfractionTest", "cfdem", "tutorials/cfdemSolverPiso/voidfractionTest", "CFD",
+             cfdem_scene(3000.0), refused="solveFlow off: the case keeps its gas still"),      # no flow solved
+    Tutorial("ErgunTestMPI_cgs", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI_cgs", "CFD",
+             cfdem_scene(2000.0), refused="are in SI; give 'units si'"),                          # units cgs
     Tutorial("heatTransfer_1", "liggghts", "heatTransfer_1", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),
              checks=liggghts_checks),
     Tutorial("heatTransfer_2", "liggghts", "heatTransfer_2", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0, T=0.0),

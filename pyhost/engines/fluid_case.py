@@ -267,38 +267,38 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     return found
 
 
-def cfdem_resolved(case: str | Path) -> str | None:
-    """Where a CFDEM case resolves its particles on the mesh (cfdemSolverIB: voidFractionModel
-    IB or bigParticle, immersed-boundary force models such as ShirgaonkarIB), or None."""
-    path = Path(case) / "constant" / "couplingProperties"
-    if not path.is_file():
+def cfdem_unsupported(case: str | Path) -> str | None:
+    """Why the host cannot run a CFDEM case as it is written, or None: particles the mesh
+    resolves (cfdemSolverIB: voidFractionModel IB or bigParticle, immersed-boundary force
+    models), species transported besides T (the eulerian fields of scalarTransportProperties,
+    scalarGeneralExchangeProps' partSpeciesNames), or a flow that is not solved (solveFlow off)."""
+    coupling = Path(case) / "constant" / "couplingProperties"
+    if not coupling.is_file():
         return None
-    f = FoamFile(path)
+    f = FoamFile(coupling)
     model = str(f.get("voidFractionModel", ""))
-    if model in ("IB", "bigParticle"):
-        return f"{path} voidFractionModel {model}"
     forces = [str(m) for m in (f.get("forceModels") or []) if str(m).endswith("IB")]
-    return f"{path} forceModels {' '.join(forces)}" if forces else None
-
-
-def cfdem_species(case: str | Path) -> list[tuple[str, str]]:
-    """The species a CFDEM case transports besides T, each with where it is named: the eulerian
-    fields of constant/scalarTransportProperties other than T, and the particles' species of
-    couplingProperties' scalarGeneralExchangeProps (partSpeciesNames)."""
-    case = Path(case)
-    found = []
-    transport = case / "constant" / "scalarTransportProperties"
+    if model in ("IB", "bigParticle") or forces:
+        where = f"voidFractionModel {model}" if model in ("IB", "bigParticle") else f"forceModels {' '.join(forces)}"
+        return (f"the case resolves its particles on the mesh (an immersed boundary, as cfdemSolverIB: {coupling} "
+                f"{where}); the host couples particles smaller than the cells, through a fluid fraction and a drag law")
+    species = [(str(name), f"{coupling} scalarGeneralExchangeProps partSpeciesNames")
+               for name in (f.get("scalarGeneralExchangeProps") or {}).get("partSpeciesNames") or [] if str(name) != "none"]
+    transport = Path(case) / "constant" / "scalarTransportProperties"
     if transport.is_file():
-        f = FoamFile(transport)
-        model = str(f.get("scalarTransportModel", ""))
-        fields = (f.get(f"{model}Props") or {}).get("eulerianFields") or []
-        found += [(str(name), f"{transport} {model}Props eulerianFields") for name in fields if str(name) != "T"]
-    coupling = case / "constant" / "couplingProperties"
-    if coupling.is_file():
-        props = FoamFile(coupling).get("scalarGeneralExchangeProps") or {}
-        found += [(str(name), f"{coupling} scalarGeneralExchangeProps partSpeciesNames")
-                  for name in props.get("partSpeciesNames") or [] if str(name) != "none"]
-    return found
+        t = FoamFile(transport)
+        kind = str(t.get("scalarTransportModel", ""))
+        species = [(str(name), f"{transport} {kind}Props eulerianFields")
+                   for name in (t.get(f"{kind}Props") or {}).get("eulerianFields") or [] if str(name) != "T"] + species
+    if species:
+        names = ", ".join(sorted({name for name, _ in species}))
+        return (f"the case transports species ({names}: {species[0][1]}); the host solves the gas flow and temperature "
+                "only: remove the species from the case (and the script's couple/cfd/speciesConvection) to run its "
+                "flow and heat")
+    if f.get("solveFlow", True) is False:
+        return (f"{coupling} solveFlow off: the case keeps its gas still (CFDEM computes only the fluid fraction and "
+                "the forces); the host always solves the gas flow: remove the entry to have the flow solved")
+    return None
 
 
 def adopt_piso(case: str | Path) -> bool:

@@ -266,6 +266,16 @@ def test_a_cfdem_case_of_resolved_particles_is_refused(tmp_path, kwargs, where):
         load_scene(cfdem_layout(tmp_path, **kwargs))
 
 
+def test_a_cfdem_case_whose_flow_is_not_solved_is_refused(tmp_path):
+    """voidfractionTest says solveFlow off (CFDEM keeps the gas still and computes the fraction
+    and the forces only): the host, which always solves the flow, ran it as a moving gas."""
+    from pyhost.scene import SceneError, load_scene
+
+    with pytest.raises(SceneError, match=r"fluid.case: .*couplingProperties solveFlow off: the case keeps its gas "
+                                         r"still .*the host always solves the gas flow"):
+        load_scene(cfdem_layout(tmp_path, props="solveFlow off;"))
+
+
 def test_mean_velocity_forces_run_as_collheatfoams(case):
     """CFDEM's meanSupVelocityForce (its Coeffs sub-dictionary, its own keys) and OpenFOAM's
     meanVelocityForce become collheatMeanVelocityForce in the copy, superficial for CFDEM's;
