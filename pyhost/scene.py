@@ -260,11 +260,12 @@ def _user_fluid_case(fluid, path, file, energy: bool):
 
 def _cfdem_settings(effects, fluid, time, dem, data, path, file):
     """A CFDEM case says its drag law, void fraction model and gas-particle heat transfer (with
-    the gas's conductivity and heat capacity) in constant/couplingProperties, and its script
-    how often it couples (``fix ... couple/cfd couple_every N``): taken where the scene does not
-    give the key (fluid.drag, fluid.void_fraction, fluid.alpha_min, effects.convection,
-    fluid.conductivity, fluid.heat_capacity, time.couple_every); a scene value that disagrees, or a model the host
-    does not have with no scene value to choose one, is refused. So is a case the host cannot run
+    the gas's conductivity and heat capacity) in constant/couplingProperties, and how often it
+    couples there too (couplingInterval, with CFDEM's in-memory exchange) or in its script
+    (``fix ... couple/cfd couple_every N``, with a file exchange): taken where the scene does not
+    give the key (fluid.drag, fluid.void_fraction, fluid.alpha_min, fluid.ddt_alpha,
+    effects.convection, fluid.conductivity, fluid.heat_capacity, time.couple_every); a scene value that disagrees,
+    or a model the host does not have with no scene value to choose one, is refused. So is a case the host cannot run
     as written (``cfdem_unsupported``: resolved particles, species, a flow not solved). Returns
     (effects, fluid, time)."""
     from pyhost.engines.fluid_case import CFDEM_KNOWN, cfdem_unsupported, coupling_properties
@@ -274,24 +275,26 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
     if why:
         raise SceneError(f"{file}: fluid.case: {why}")
     where = folder / "constant" / "couplingProperties"
-    tables = {"effects": effects, "fluid": fluid}
-    taken = {"effects": {}, "fluid": {}}
-    for scene_key, (entry, theirs, ours) in coupling_properties(folder).items():
+    tables = {"effects": effects, "fluid": fluid, "time": time}
+    taken = {"effects": {}, "fluid": {}, "time": {}}
+    found = coupling_properties(folder)
+    for scene_key, (entry, theirs, ours) in found.items():
         table, key = scene_key.split(".")
         value = getattr(tables[table], key)
         given = key in data.get(table, {})
         agree = (math.isclose(value, ours, rel_tol=1e-12) if isinstance(ours, float) else value == ours)
+        said = f"{where}{' ' + entry if entry else ''} has {theirs}"
         if given and ours is not None and not agree:
-            raise SceneError(f"{file}: {scene_key}: {value!r}, but {where} {entry} has {theirs} ({ours!r}): remove "
-                             f"{scene_key} to take the case's, or make them agree")
+            raise SceneError(f"{file}: {scene_key}: {value!r}, but {said} ({ours!r}): remove {scene_key} to take the "
+                             "case's, or make them agree")
         if not given and ours is None:
             known = CFDEM_KNOWN[scene_key]
-            raise SceneError(f"{file}: {scene_key}: {where} {entry} has {theirs}, which the host does not have "
+            raise SceneError(f"{file}: {scene_key}: {said}, which the host does not have "
                              f"(it has {', '.join(f'{a} as {b!r}' for a, b in known.items())}): give {scene_key} "
                              "to choose")
         if not given:
             taken[table][key] = ours
-    if dem.script:
+    if dem.script and "time.couple_every" not in found:       # (a file exchange: the script's interval)
         every = _script_couple_every(path.resolve().parent / dem.script)
         if every is not None:
             number, line = every
@@ -299,8 +302,8 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
                 raise SceneError(f"{file}: time.couple_every: {time.couple_every}, but {line} couples every "
                                  f"{number} DEM steps (fix couple/cfd): remove time.couple_every to take the "
                                  "script's, or make them agree")
-            time = dataclasses.replace(time, couple_every=number)
-    return (dataclasses.replace(effects, **taken["effects"]), dataclasses.replace(fluid, **taken["fluid"]), time)
+            taken["time"]["couple_every"] = number
+    return tuple(dataclasses.replace(tables[k], **taken[k]) for k in ("effects", "fluid", "time"))
 
 
 def _script_couple_every(script: Path) -> tuple[int, str] | None:

@@ -153,7 +153,12 @@ class Fluid:
                      "when this key is absent (KochHillDrag, DiFeliceDrag, GidaspowDrag)")
     cells: list = spec(default=[10, 1, 30], doc="cells in x, y, z")
     sides: str = spec("in:slip,wall", "slip", "the four side faces of the fluid box")
-    alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]")
+    alpha_min: float = spec(">0", 0.3, "floor of the fluid fraction given to the solver [-]; a CFDEM case's "
+                                       "couplingProperties gives it when this key is absent (its void fraction "
+                                       "model's alphaMin, CFDEM's default 0.1)")
+    ddt_alpha: bool = spec(default=True, doc="d(alpha)/dt in the gas continuity equation; a CFDEM case's "
+                                             "couplingProperties gives it when this key is absent (useDDTvoidfraction: "
+                                             "b true, off or absent false, as CFDEM's solvers)")
     void_fraction: str = spec("in:centre,divided", "centre",
                               "how a particle's volume and drag go to the fluid cells: all to the cell of its "
                               "centre, or divided over the cells it overlaps (CFDEM's divided model; for cells "

@@ -92,7 +92,7 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
             props.update({"Cp": f.heat_capacity, "kappa": f.conductivity})
         _mesh(folder, source, str(scene.path))
         return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
-                           void_fraction=f.void_fraction, restart=restart).start()
+                           void_fraction=f.void_fraction, restart=restart, ddt_alpha=f.ddt_alpha).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
@@ -106,7 +106,7 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
                     T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
                     T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
     return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
-                       void_fraction=f.void_fraction, restart=restart).start()
+                       void_fraction=f.void_fraction, restart=restart, ddt_alpha=f.ddt_alpha).start()
 
 
 def _mesh(case: Path, source: Path, file: str) -> None:

@@ -312,6 +312,9 @@ TUTORIALS = [
              changes=[mkdir("DEM", "post", "restart"),
                       drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1")],
              native_first=("DEM", "in.liggghts_init"), checks=ergun_checks),
+    Tutorial("ErgunTestMPI_np4", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI", "CFD",
+             cfdem_scene(2000.0), changes=[mkdir("DEM", "post", "restart")],          # as it is, on its 4 ranks
+             native_first=("DEM", "in.liggghts_init"), ranks=4, checks=ergun_checks),
     Tutorial("ErgunTestMPI_restart", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI_restart", "CFD",
              cfdem_scene(2000.0) + "\n[output]\ncheckpoint = 0.01\npictures = false\n",
              changes=[mkdir("DEM", "post", "restart"),

@@ -219,8 +219,15 @@ CFDEM_NUSSELT = {"LiMason": "li_mason", "Gunn": "gunn", "Deen": "deen"}
 """CFDEM's Nusselt correlations (LaEuScalarTemp's NuCorrelation, scalarGeneralExchange's
 switches) the host has, as plugins.convection names. CFDEM forms Re on the interstitial slip
 d |U - v| / nu, the host (and the correlations' authors) on the superficial alpha d |U - v| / nu."""
+CFDEM_DDT = {"off": False, "b": True}
+"""CFDEM's useDDTvoidfraction values the host has, as fluid.ddt_alpha (its "a", the particles'
+flux divergence in place of d(alpha)/dt, it has not)."""
+MPI_EXCHANGE = ("twoWayMPI", "twoWayM2M")
+"""CFDEM's in-memory data exchange models: CFDEM runs the DEM couplingInterval steps per
+coupling, whatever the script's ``fix couple/cfd couple_every`` says (LIGGGHTS: "couple_every as
+specified in LIGGGHTS is overriden by calling external program")."""
 CFDEM_KNOWN = {"fluid.drag": CFDEM_DRAG, "fluid.void_fraction": CFDEM_VOID_FRACTION,
-               "effects.convection": CFDEM_NUSSELT}
+               "effects.convection": CFDEM_NUSSELT, "fluid.ddt_alpha": CFDEM_DDT}
 """The scene keys a CFDEM model name goes to, with the names the host has."""
 
 
@@ -231,7 +238,9 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     (voidFractionModel) and the floor of the fluid fraction (its Props' alphaMin), the gas-particle heat transfer (forceModels' LaEuScalarTemp and its
     NuCorrelation, default LiMason; scalarGeneralExchange: useLiMason, useGeneralCorrelation,
     else Deen) and the gas's conductivity [W/(m K)] and heat capacity [J/(kg K)] that model
-    names (lambda, Cp); {} without the file. Several drag models in forceModels are given as one
+    names (lambda, Cp), whether d(alpha)/dt is in the continuity equation (useDDTvoidfraction,
+    CFDEM's default off), and the DEM steps per coupling (couplingInterval, with an in-memory
+    exchange: ``MPI_EXCHANGE``); {} without the file. Several drag models in forceModels are given as one
     joined by '+' (the host has one law)."""
     path = Path(case) / "constant" / "couplingProperties"
     if not path.is_file():
@@ -250,6 +259,13 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
         if str(model) in CFDEM_VOID_FRACTION:   # (CFDEM's divided and centre clip at alphaMin, default 0.1)
             found["fluid.alpha_min"] = ((f"{model}Props alphaMin", f"{floor:g}", float(floor)) if floor is not None
                                         else (f"{model}Props", "no alphaMin: CFDEM's default 0.1", CFDEM_ALPHA_MIN))
+    ddt = f.get("useDDTvoidfraction")
+    ddt = "off" if ddt is False else str(ddt).strip('"') if ddt is not None else None
+    found["fluid.ddt_alpha"] = (("useDDTvoidfraction", ddt, CFDEM_DDT.get(ddt)) if ddt is not None
+                                else ("", "no useDDTvoidfraction: CFDEM's default off", False))
+    interval = f.get("couplingInterval")
+    if str(f.get("dataExchangeModel", "")) in MPI_EXCHANGE and isinstance(interval, int) and interval > 0:
+        found["time.couple_every"] = ("couplingInterval", f"{interval}", interval)
     for heat in ("LaEuScalarTemp", "scalarGeneralExchange"):
         if heat not in models:
             continue

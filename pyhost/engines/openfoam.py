@@ -127,13 +127,15 @@ class FluidSolver:
     each cell (W), :meth:`temperature` gives the cells' T.
 
     ``restart``: a folder of :meth:`save` to continue from (its time becomes the start time).
+    ``ddt_alpha``: d(alpha)/dt in the continuity equation (False: left out, as CFDEM's solvers
+    by default, ``collheatFoam -noDdtAlpha``).
 
     Use ``with FluidSolver(case) as fluid: ...`` or :meth:`start` / :meth:`stop`.
     """
 
     def __init__(self, case: str | os.PathLike, *, nprocs: int = 1, drag: str = "gidaspow",
                  alpha_min: float = 0.3, timeout: float = TIMEOUT, energy: bool = False,
-                 void_fraction: str = "centre", restart: str | os.PathLike | None = None):
+                 void_fraction: str = "centre", restart: str | os.PathLike | None = None, ddt_alpha: bool = True):
         self.case = Path(case).resolve()
         if not (self.case / "system" / "controlDict").is_file():
             raise FluidError(f"{self.case} is not an OpenFOAM case (no system/controlDict)")
@@ -145,6 +147,7 @@ class FluidSolver:
         if void_fraction not in ("centre", "divided"):
             raise ValueError(f"void_fraction must be centre or divided, got {void_fraction!r}")
         self.void_fraction = void_fraction
+        self.ddt_alpha = ddt_alpha
         props = FoamFile(self.case / "constant" / "transportProperties")
         self.nu = _value(props["nu"])
         self.rho = _value(props["rho"])
@@ -171,7 +174,8 @@ class FluidSolver:
             raise FluidError(f"{SOLVER} is missing: run tools/setup.sh --engines")
         if not (self.case / "constant" / "polyMesh" / "owner").is_file():
             run_utility(self.case, "blockMesh")
-        command = [str(SOLVER), "-case", str(self.case)] + (["-energy"] if self.energy else [])
+        command = ([str(SOLVER), "-case", str(self.case)] + (["-energy"] if self.energy else [])
+                   + ([] if self.ddt_alpha else ["-noDdtAlpha"]))
         if self.nprocs > 1:
             for old in self.case.glob("processor*"):
                 shutil.rmtree(old)

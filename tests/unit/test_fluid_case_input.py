@@ -172,6 +172,42 @@ def test_a_model_the_host_lacks_runs_with_the_scenes_choice(tmp_path):
     assert (scene.fluid.drag, scene.fluid.void_fraction) == ("wenyu", "centre")
 
 
+def test_a_cfdem_cases_coupling_interval_is_its_couplingInterval(tmp_path):
+    """With CFDEM's in-memory exchange (twoWayMPI, every tutorial's) CFDEM runs the DEM
+    couplingInterval steps per coupling, whatever the script's couple_every (LIGGGHTS says it
+    is overridden): ErgunTestMPI 50 where its script says 100, packedBedTemp 500 where it
+    says 100; the host took the script's. With a file exchange the script's stands."""
+    from pyhost.scene import SceneError, load_scene
+
+    mpi = "dataExchangeModel twoWayMPI;\ncouplingInterval 50;"
+    assert load_scene(cfdem_layout(tmp_path / "a", props=mpi)).time.couple_every == 50
+    assert load_scene(cfdem_layout(tmp_path / "b", props=mpi, time="couple_every = 50\n")).time.couple_every == 50
+    files = "dataExchangeModel twoWayFiles;\ncouplingInterval 50;"
+    assert load_scene(cfdem_layout(tmp_path / "c", props=files)).time.couple_every == 100
+    with pytest.raises(SceneError, match=r"time.couple_every: 100, but .*couplingProperties couplingInterval has 50 "
+                                         r"\(50\): remove time.couple_every"):
+        load_scene(cfdem_layout(tmp_path / "d", props=mpi, time="couple_every = 100\n"))
+
+
+def test_a_cfdem_cases_ddt_voidfraction_is_taken(tmp_path):
+    """CFDEM's solvers leave d(alpha)/dt out of the continuity equation unless
+    useDDTvoidfraction says b (or a); every tutorial but one keeps the default off, and the
+    host solved it in: a packed bed's jiggling beads then drove the gas, its pressure drop
+    scattering by 10 % from write to write (ErgunTestMPI). Taken for fluid.ddt_alpha; "a"
+    (the particles' flux divergence) the host does not have."""
+    from pyhost.scene import SceneError, load_scene
+
+    assert load_scene(cfdem_layout(tmp_path / "a")).fluid.ddt_alpha is False
+    assert load_scene(cfdem_layout(tmp_path / "b", props="useDDTvoidfraction b;")).fluid.ddt_alpha is True
+    assert load_scene(cfdem_layout(tmp_path / "c", props="useDDTvoidfraction off;")).fluid.ddt_alpha is False
+    with pytest.raises(SceneError, match=r"fluid.ddt_alpha: True, but .*couplingProperties has no useDDTvoidfraction: "
+                                         r"CFDEM's default off \(False\): remove fluid.ddt_alpha"):
+        load_scene(cfdem_layout(tmp_path / "d", fluid="ddt_alpha = true\n"))
+    with pytest.raises(SceneError, match=r"fluid.ddt_alpha: .*useDDTvoidfraction has a, which the host does not have "
+                                         r"\(it has off as False, b as True\)"):
+        load_scene(cfdem_layout(tmp_path / "e", props="useDDTvoidfraction a;"))
+
+
 def test_a_cfdem_cases_fluid_fraction_floor_is_taken(tmp_path):
     """CFDEM's divided and centre models clip the fluid fraction at their Props' alphaMin
     (packedBedTemp 0.4, ErgunTestMPI_restart 0.01), 0.1 without it (ErgunTestMPI): taken for

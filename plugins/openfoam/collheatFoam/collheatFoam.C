@@ -53,6 +53,8 @@ int main(int argc, char *argv[])
     argList::addOption("link", "dir", "serve the Python host through pipes in dir");
     argList::addBoolOption("energy", "solve the gas temperature T (Cp, kappa in transportProperties)");
     argList::addBoolOption("restart", "continue from a start time the host wrote (its alpha is the old one)");
+    argList::addBoolOption("noDdtAlpha", "leave d(alpha)/dt out of the continuity equation (CFDEM's default, "
+                           "useDDTvoidfraction off)");
 
     #include "setRootCaseLists.H"
     #include "createTime.H"
