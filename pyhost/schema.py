@@ -65,7 +65,8 @@ class Effects:
     wall_heat: bool = spec(default=True, doc="collisions with walls at a fixed temperature exchange heat")
     convection: str = spec("in:none," + ",".join(sorted(CORRELATIONS)), "none",
                            "gas-particle convection: Nusselt correlation (plugins.convection); turns on the "
-                           "gas energy equation of the fluid")
+                           "gas energy equation of the fluid; a CFDEM case's couplingProperties gives it when "
+                           "this key is absent (LaEuScalarTemp's NuCorrelation, scalarGeneralExchange)")
 
     @property
     def heat_models(self) -> tuple:
@@ -164,8 +165,10 @@ class Fluid:
                               "centre, or divided over the cells it overlaps (CFDEM's divided model; for cells "
                               "less than about 3 particle diameters wide); a CFDEM case's couplingProperties "
                               "voidFractionModel gives it when this key is absent")
-    conductivity: float = spec(">0", 0.026, "gas thermal conductivity [W/(m K)] (with effects.convection)")
-    heat_capacity: float = spec(">0", 1005.0, "gas specific heat capacity [J/(kg K)] (with effects.convection)")
+    conductivity: float = spec(">0", 0.026, "gas thermal conductivity [W/(m K)] (with effects.convection; a CFDEM "
+                                            "case's heat transfer model's lambda gives it when this key is absent)")
+    heat_capacity: float = spec(">0", 1005.0, "gas specific heat capacity [J/(kg K)] (with effects.convection; a "
+                                              "CFDEM case's heat transfer model's Cp gives it when this key is absent)")
     temperature: float = spec(">0", 293.15, "initial gas temperature [K] (with effects.convection)")
     inlet_temperature: float = spec(">=0", 0.0, "gas temperature at the inlet [K]; 0: the initial temperature")
     ranks: int = spec(">0", 1, "MPI ranks of the fluid solver, started as a job of its own (mpirun -np, "
@@ -207,8 +210,9 @@ class Time:
     sample_every: int = spec(">0", 1, "DEM steps between harvests of the contact events with restitution "
                                       "feedback: a contact shorter than this gets its separation speed at the "
                                       "harvest, late (restitution_late in summary.json)")
-    couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges; a script's fix couple/cfd "
-                                       "couple_every (CFDEM's) gives it when this key is absent")
+    couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges; a CFDEM case's couplingInterval "
+                                       "(its in-memory exchange, twoWayMPI), else its script's fix couple/cfd "
+                                       "couple_every, gives it when this key is absent")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
 
 
