@@ -148,12 +148,11 @@ class Dem:
         added commands (printed once)."""
         from pyhost.engines.events import fix_command
 
-        units = self.lmp.unit_style()
+        units, style, spheres = self.lmp.styles()
         if units != "si":       # (a read_restart brings its file's units, a script without any LIGGGHTS' lj)
             raise ScriptError(f"the script runs in LIGGGHTS' units {units}: the host's contact models, heat and "
                               "energy balance are in SI; give 'units si' before the box (and the script's values "
                               "in SI)")
-        style, spheres = self.lmp.atom_style()
         if not spheres:         # (the contact recorder and every effect read each atom's radius and mass)
             raise ScriptError(f"the script's atoms are LIGGGHTS' atom_style {style}, not spheres with a radius and a "
                               "mass each: the host's contact, heat and drag models are for spheres (atom_style "

@@ -411,16 +411,13 @@ class Liggghts:
         raw = self.lib.lammps_extract_global(self.ptr, b"ntimestep")
         return ctypes.cast(raw, ctypes.POINTER(ctypes.c_int64))[0]
 
-    def unit_style(self) -> str:
-        """LIGGGHTS' unit style now: the script's ``units``, a restart file's, or LIGGGHTS'
-        default (lj)."""
-        return self.helper.collheat_unit_style(self.ptr).decode()
-
-    def atom_style(self) -> tuple[str, bool]:
-        """LIGGGHTS' atom style now (the script's ``atom_style``, a restart file's, or the
-        default atomic) and whether its atoms are plain spheres (radius and mass per atom, no
-        other shape)."""
-        return self.helper.collheat_atom_style(self.ptr).decode(), bool(self.helper.collheat_sphere_atoms(self.ptr))
+    def styles(self) -> tuple[str, str, bool]:
+        """LIGGGHTS' unit style now (the script's ``units``, a restart file's, or the default lj),
+        its atom style (the script's ``atom_style``, a restart file's, or the default atomic) and
+        whether its atoms are plain spheres (radius and mass per atom, no other shape)."""
+        h = self.helper
+        return (h.collheat_unit_style(self.ptr).decode(), h.collheat_atom_style(self.ptr).decode(),
+                bool(h.collheat_sphere_atoms(self.ptr)))
 
     def dump_every(self) -> int:
         """The interval [steps] of the most frequent dump defined now with a fixed interval
