@@ -264,10 +264,10 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
     couples there too (couplingInterval, with CFDEM's in-memory exchange) or in its script
     (``fix ... couple/cfd couple_every N``, with a file exchange): taken where the scene does not
     give the key (fluid.drag, fluid.void_fraction, fluid.alpha_min, fluid.ddt_alpha,
-    effects.convection, fluid.conductivity, fluid.heat_capacity, time.couple_every); a scene value that disagrees,
-    or a model the host does not have with no scene value to choose one, is refused. So is a case the host cannot run
-    as written (``cfdem_unsupported``: resolved particles, species, a flow not solved). Returns
-    (effects, fluid, time)."""
+    effects.convection, fluid.conductivity, fluid.heat_capacity, time.couple_every); a scene
+    value that disagrees, or a model the host does not have with no scene value to choose one,
+    is refused. So is a case the host cannot run as written (``cfdem_unsupported``: resolved
+    particles, species, a flow not solved). Returns (effects, fluid, time)."""
     from pyhost.engines.fluid_case import CFDEM_KNOWN, cfdem_unsupported, coupling_properties
 
     folder = path.resolve().parent / fluid.case

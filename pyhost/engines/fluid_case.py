@@ -234,14 +234,17 @@ CFDEM_KNOWN = {"fluid.drag": CFDEM_DRAG, "fluid.void_fraction": CFDEM_VOID_FRACT
 def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     """What a CFDEM case's constant/couplingProperties says that a scene key also says, by
     scene key: ``{"fluid.drag": (entry, CFDEM's value, the host's value or None where it has
-    none), ...}`` for the drag law (forceModels), how a particle's volume goes to the cells
-    (voidFractionModel) and the floor of the fluid fraction (its Props' alphaMin), the gas-particle heat transfer (forceModels' LaEuScalarTemp and its
-    NuCorrelation, default LiMason; scalarGeneralExchange: useLiMason, useGeneralCorrelation,
-    else Deen) and the gas's conductivity [W/(m K)] and heat capacity [J/(kg K)] that model
-    names (lambda, Cp), whether d(alpha)/dt is in the continuity equation (useDDTvoidfraction,
-    CFDEM's default off), and the DEM steps per coupling (couplingInterval, with an in-memory
-    exchange: ``MPI_EXCHANGE``); {} without the file. Several drag models in forceModels are given as one
-    joined by '+' (the host has one law)."""
+    none), ...}``; {} without the file. The keys:
+
+    - the drag law (forceModels; several drag models are given as one joined by '+': the host
+      has one law);
+    - how a particle's volume goes to the cells (voidFractionModel) and the floor of the fluid
+      fraction (its Props' alphaMin, CFDEM's default 0.1);
+    - whether d(alpha)/dt is in the continuity equation (useDDTvoidfraction, CFDEM's default off);
+    - the DEM steps per coupling (couplingInterval, with an in-memory exchange: ``MPI_EXCHANGE``);
+    - the gas-particle heat transfer (forceModels' LaEuScalarTemp and its NuCorrelation, default
+      LiMason; scalarGeneralExchange: useLiMason, useGeneralCorrelation, else Deen) and the
+      gas's conductivity [W/(m K)] and heat capacity [J/(kg K)] that model names (lambda, Cp)."""
     path = Path(case) / "constant" / "couplingProperties"
     if not path.is_file():
         return {}
@@ -298,8 +301,9 @@ def cfdem_unsupported(case: str | Path) -> str | None:
         where = f"voidFractionModel {model}" if model in ("IB", "bigParticle") else f"forceModels {' '.join(forces)}"
         return (f"the case resolves its particles on the mesh (an immersed boundary, as cfdemSolverIB: {coupling} "
                 f"{where}); the host couples particles smaller than the cells, through a fluid fraction and a drag law")
+    exchange = f.get("scalarGeneralExchangeProps") or {}
     species = [(str(name), f"{coupling} scalarGeneralExchangeProps partSpeciesNames")
-               for name in (f.get("scalarGeneralExchangeProps") or {}).get("partSpeciesNames") or [] if str(name) != "none"]
+               for name in exchange.get("partSpeciesNames") or [] if str(name) != "none"]
     transport = Path(case) / "constant" / "scalarTransportProperties"
     if transport.is_file():
         t = FoamFile(transport)
