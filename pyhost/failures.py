@@ -37,6 +37,30 @@ class ParticlesLost(SimulationFailed):
         self.ids, self.position, self.velocity, self.time, self.cause = ids, position, velocity, time, cause
 
 
+class DragUnresolved(SimulationFailed):
+    """The gas's drag, held over a coupling interval, would carry particles past the gas speed
+    within it: K interval / m > 1."""
+
+
+def drag_unresolved(ids, k, mass, d, interval: float, dem_step: float, t: float) -> DragUnresolved | None:
+    """The failure of particles whose drag relaxes their slip faster than the coupling interval
+    [s]: ``k`` the drag coefficient K [kg/s] and ``mass`` [kg], ``d`` the diameter [m] of each
+    particle (``ids``); None if K interval / m <= 1 for all. The host's drag force is explicit
+    over the interval: the slip changes by the factor 1 - K interval / m, which overshoots
+    past 1 and grows past 2."""
+    ratio = np.asarray(k) * interval / np.asarray(mass)
+    if not len(ratio) or ratio.max() <= 1.0:
+        return None
+    i = int(np.argmax(ratio))
+    tau = mass[i] / k[i]
+    return DragUnresolved(
+        f"t = {t:.6g} s: the gas's drag relaxes the slip of {int((ratio > 1).sum())} particle(s) faster than the "
+        f"coupling interval of {interval:.3g} s (particle {int(ids[i])}, d = {d[i] * 1e3:.3g} mm: m/K = {tau:.3g} s, "
+        f"K interval/m = {ratio[i]:.3g}); the host's drag is held over the interval, so it carries them past the gas "
+        f"speed and their motion is wrong: couple at most every {max(1, int(tau / dem_step))} DEM steps "
+        "(time.couple_every; a CFDEM case: its couplingInterval)")
+
+
 def heading(scene, x, v) -> str:
     """The face of the box a particle at x moving at v reaches first (periodic axes skipped)."""
     box = np.asarray(scene.domain.box, float)

@@ -12,6 +12,7 @@ import numpy as np
 
 from plugins import convection
 from pyhost.effects import Effect, by_id
+from pyhost.failures import drag_unresolved
 from pyhost.output import VtkSeries
 
 TOTAL_TOLERANCE = 1e-4
@@ -81,6 +82,10 @@ class FluidExchange(Effect):
         x = np.where(periodic, lo + np.mod(atoms.x - lo, hi - lo), atoms.x)   # the DEM wraps only at re-neighbouring
         interval = loop.every["couple"] * loop.dem.dt
         forces = self.fluid.particle_forces(x, atoms.v, 2.0 * atoms.radius)
+        failure = drag_unresolved(atoms.id, self.fluid.exchange, atoms.mass, 2.0 * atoms.radius, interval,
+                                  loop.dem.dt, loop.t)
+        if failure is not None:
+            raise failure
         self.fluid.advance(interval, heat=self.convect(atoms, interval) if self.convection else None,
                            wait=not self.overlap)
         loop.dem.set_force(forces)

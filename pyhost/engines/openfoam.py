@@ -345,8 +345,8 @@ class FluidSolver:
         """Fluid force on each particle (N, shape (n, 3)) from the current fluid: drag
         ``K (u - v)`` plus pressure gradient ``-V_p grad p``; also sets the per-cell fluid
         fraction, exchange coefficient Ksl and particle velocity Us used by the next
-        :meth:`advance`, and keeps each particle's cell (``self.cell``) and slip speed
-        |u - v| (``self.slip``, m/s). ``x`` positions (m), ``v`` velocities (m/s), ``d``
+        :meth:`advance`, and keeps each particle's cell (``self.cell``), slip speed
+        |u - v| (``self.slip``, m/s) and drag coefficient K (``self.exchange``, kg/s). ``x`` positions (m), ``v`` velocities (m/s), ``d``
         diameters (m)."""
         x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 3)
         v = np.asarray(v, dtype=np.float64).reshape(-1, 3)
@@ -367,6 +367,7 @@ class FluidSolver:
         slip = u - v
         self.cell, self.slip = cell, np.linalg.norm(slip, axis=1)
         k = self.drag_law(np.sum(alpha[cells] * share, axis=1), self.slip, d, self.rho, self.nu)
+        self.exchange = k
         ksum = spread(k)
         kv = np.stack([spread(k * v[:, i]) for i in range(3)], axis=1)
         self._alpha = alpha

@@ -3,6 +3,7 @@ LIGGGHTS' Temp): one particle in a hot stream against the lumped solution, and t
 particles and gas together against what crossed the fluid's boundaries."""
 import csv
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -212,3 +213,69 @@ def test_gas_energy_on_one_and_two_ranks(tmp_path):
             assert fluid.boundary_heat > 0.1                   # the hot inlet's enthalpy came in
             temperatures[n] = T[np.lexsort(np.round(fluid.cell_centres, 9).T)]
     assert np.abs(temperatures[1] - temperatures[2]).max() < 1e-3
+
+
+FINE = """
+[effects]
+fluid = true
+
+[materials.glass]
+density = 2500.0
+youngs_modulus = 63e9
+poisson_ratio = 0.23
+yield_stress = 500e6
+heat_capacity = 840.0
+conductivity = 1.0
+dem = {{ youngs_modulus = 5e6, restitution = 0.9 }}
+
+[[particles]]
+material = "glass"
+count = 1
+radius = 1e-5
+temperature = 300.0
+positions = [[0.0005, 0.0005, 0.0015]]
+
+[time]
+dem_step = 1e-7
+end = 2e-4
+couple_every = {couple}
+
+[fluid]                             # water, at rest
+density = 1000.0
+viscosity = 1e-3
+inlet_velocity = 0.0
+cells = [1, 1, 4]
+
+[domain]
+box = [0.0, 0.001, 0.0, 0.001, 0.0, 0.002]
+
+[output]
+vtk = false
+pictures = false
+"""
+
+
+@pytest.mark.parametrize("couple", [100, 1000])
+def test_drag_faster_than_the_coupling_interval_stops_the_run(tmp_path, couple):
+    """A 20 um glass sphere in water: its drag relaxes its slip in m/K = rho_p d^2 / (18 mu) =
+    5.6e-5 s (Stokes, at the start). Coupled every 1000 DEM steps of 0.1 us (0.1 ms), the
+    host's drag, held over the interval, would carry it past the water's speed (K interval/m
+    = 1.8): the run stops (exit 3) naming the particle and the interval to use, and its summary
+    is written. Every 100 steps (K interval/m = 0.18) it runs."""
+    (tmp_path / "case.toml").write_text(FINE.format(couple=couple))
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=600)
+    if couple == 100:
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        return
+    assert r.returncode == 3, r.stdout[-3000:] + r.stderr[-3000:]
+    tau = 2500.0 * (2e-5) ** 2 / (18 * 1e-3)
+    assert "the gas's drag relaxes the slip of 1 particle(s) faster than the coupling interval of 0.0001 s" in r.stderr
+    found = re.search(r"m/K = ([0-9.e+-]+) s, K interval/m = ([0-9.]+)\); .* couple at most every (\d+) DEM steps",
+                      r.stderr)
+    assert found, r.stderr
+    relax, ratio, steps = float(found[1]), float(found[2]), int(found[3])
+    print(f"m/K {relax:.4g} s (Stokes {tau:.4g} s), K interval/m {ratio}, couple every {steps} steps at most")
+    assert relax == pytest.approx(tau, rel=0.02)             # Wen-Yu at Re ~ 1e-2 and alpha ~ 1: Stokes
+    assert ratio == pytest.approx(1e-4 / relax, rel=0.01) and steps == int(relax / 1e-7)
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["status"].startswith("stopped at t = 0.0001 s by DragUnresolved")
