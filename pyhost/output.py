@@ -23,6 +23,8 @@ from pathlib import Path
 import meshio
 import numpy as np
 
+from pyhost import signals
+
 
 @contextlib.contextmanager
 def _naming(path: Path):
@@ -370,7 +372,14 @@ def _output_writer():
     global _writer
     if _writer is None:
         from concurrent.futures import ThreadPoolExecutor
-        _writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="output-writer")
+        # A stop (pyhost.signals) raised between the start of the pool's thread and its
+        # registration for the interpreter's exit left that thread waiting for work nobody
+        # would send, and the process waiting for it at exit, forever, after it had said it
+        # stopped cleanly (a SIGINT at the first frame). The thread starts with stops deferred.
+        with signals.deferred():
+            writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="output-writer")
+            writer.submit(int).result()
+            _writer = writer
     return _writer
 
 

@@ -220,3 +220,40 @@ def test_a_frame_that_cannot_be_written_fails_the_next_call(tmp_path):
     with pytest.raises(FileNotFoundError, match="p_00000.vtu"):
         series.write(0.0, np.zeros((1, 3)), temperature=np.ones(1))
         series.flush()
+
+
+def test_a_stop_as_the_writer_thread_starts_leaves_it_joinable(monkeypatch):
+    """A signal that lands right after the output writer's thread starts (the first VTK frame:
+    test_interrupts' SIGINT at the first history row) used to raise inside the thread pool's
+    submit, before the pool registered the thread for the interpreter's exit: the thread then
+    waited for work forever and the process, having said it stopped cleanly, never exited (a
+    CI run timed out after 60 s; py-spy showed the main thread in threading._shutdown). The
+    thread now starts with stops deferred: the stop is raised after, and the thread is
+    registered."""
+    import concurrent.futures.thread as pool
+    import os
+    import signal
+    import threading
+
+    from pyhost import output, signals
+
+    start = threading.Thread.start
+
+    def start_then_signal(self):
+        start(self)
+        if self.name.startswith("output-writer"):
+            os.kill(os.getpid(), signal.SIGINT)
+
+    before = set(threading.enumerate())            # (earlier tests' writer stays theirs)
+    monkeypatch.setattr(output, "_writer", None)
+    monkeypatch.setattr(threading.Thread, "start", start_then_signal)
+    with signals.stopping(), pytest.raises(signals.Interrupted):
+        output._output_writer().submit(int).result()        # as VtkSeries and CsvLog hand it work
+    writers = [t for t in set(threading.enumerate()) - before if t.name.startswith("output-writer")]
+    try:
+        assert writers and all(t in pool._threads_queues for t in writers)
+    finally:                          # ended here: an orphaned thread would keep pytest from exiting
+        if output._writer is not None:
+            output._writer.shutdown()
+        for t in writers:
+            t.join(timeout=10)
