@@ -346,8 +346,8 @@ class FluidSolver:
         ``K (u - v)`` plus pressure gradient ``-V_p grad p``; also sets the per-cell fluid
         fraction, exchange coefficient Ksl and particle velocity Us used by the next
         :meth:`advance`, and keeps each particle's cell (``self.cell``), slip speed
-        |u - v| (``self.slip``, m/s) and drag coefficient K (``self.exchange``, kg/s). ``x`` positions (m), ``v`` velocities (m/s), ``d``
-        diameters (m)."""
+        |u - v| (``self.slip``, m/s) and drag coefficient K (``self.exchange``, kg/s). ``x``
+        positions (m), ``v`` velocities (m/s), ``d`` diameters (m)."""
         x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 3)
         v = np.asarray(v, dtype=np.float64).reshape(-1, 3)
         d = np.broadcast_to(np.asarray(d, dtype=np.float64), (len(x),))
