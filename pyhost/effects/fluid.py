@@ -86,8 +86,8 @@ class FluidExchange(Effect):
                                   loop.dem.dt, loop.t)
         if failure is not None:
             raise failure
-        self.fluid.advance(interval, heat=self.convect(atoms, interval) if self.convection else None,
-                           wait=not self.overlap)
+        self.fluid.advance(interval, self.fluid.substeps(interval),
+                           heat=self.convect(atoms, interval) if self.convection else None, wait=not self.overlap)
         loop.dem.set_force(forces)
         self.force = (atoms.id.copy(), forces)
 

@@ -129,6 +129,8 @@ class FluidSolver:
     ``restart``: a folder of :meth:`save` to continue from (its time becomes the start time).
     ``ddt_alpha``: d(alpha)/dt in the continuity equation (False: left out, as CFDEM's solvers
     by default, ``collheatFoam -noDdtAlpha``).
+    ``deltaT``: the case's own time step [s] (controlDict): :meth:`substeps` splits a coupling
+    interval into steps no longer than it.
 
     Use ``with FluidSolver(case) as fluid: ...`` or :meth:`start` / :meth:`stop`.
     """
@@ -148,6 +150,7 @@ class FluidSolver:
             raise ValueError(f"void_fraction must be centre or divided, got {void_fraction!r}")
         self.void_fraction = void_fraction
         self.ddt_alpha = ddt_alpha
+        self.deltaT = _value(FoamFile(self.case / "system" / "controlDict")["deltaT"])   # s, the case's step
         props = FoamFile(self.case / "constant" / "transportProperties")
         self.nu = _value(props["nu"])
         self.rho = _value(props["rho"])
@@ -456,6 +459,14 @@ class FluidSolver:
         way if one is."""
         self.wait()
         return self._boundary_heat
+
+    def substeps(self, interval: float) -> int:
+        """Fluid steps in a coupling interval [s]: the interval over the case's deltaT, rounded
+        where it is a whole number within 1e-6 (every CFDEM tutorial's deltaT is its coupling
+        time: one step; CFDEM runs shorter ones as sub-steps), else up, so that no step is
+        longer than deltaT."""
+        n = interval / self.deltaT
+        return max(1, round(n) if abs(n - round(n)) <= 1e-6 * n else math.ceil(n))
 
     def couple(self, x, v, d, duration: float, steps: int = 1) -> np.ndarray:
         """One coupling step: the force on each particle (N) from the current fluid, then the

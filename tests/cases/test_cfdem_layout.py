@@ -119,6 +119,23 @@ def test_time_end_and_test_cut_the_driven_run(tmp_path):
     assert velocities(cfd)[-1, 0] == pytest.approx(0.005)
 
 
+def test_a_coupling_interval_longer_than_the_cases_deltaT_runs_in_its_steps(tmp_path):
+    """The case's controlDict asks deltaT = 0.25 ms, a quarter of the coupling interval (100
+    DEM steps of 10 us): the fluid advances each interval in 4 steps of 0.25 ms (as CFDEM's
+    sub-steps), where the host used to replace deltaT by the interval; with deltaT = 1 ms, one
+    step. Counted in the solver's own log over 0.01 s: 11 intervals (the fluid goes one
+    interval ahead of the DEM at the start)."""
+    steps = {}
+    for dt in (2.5e-4, 1e-3):
+        cfd = cfdem_case(tmp_path / str(dt), end=0.01)
+        FoamFile(cfd / "system" / "controlDict")["deltaT"] = dt
+        r = run(cfd)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        log = (cfd / "output" / "fluid" / "log.collheatFoam").read_text()
+        steps[dt] = sum(1 for line in log.splitlines() if line.startswith("Time = "))
+    assert steps == {2.5e-4: 44, 1e-3: 11}
+
+
 def test_dem_table_that_disagrees_with_the_script_is_refused(tmp_path):
     cfd = cfdem_case(tmp_path, dem="dem = { youngs_modulus = 1e7, restitution = 0.3 }")
     r = run(cfd)
