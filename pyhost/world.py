@@ -69,6 +69,8 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
 
     f = scene.fluid
     energy = scene.effects.convection != "none"
+    solver = dict(drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks, void_fraction=f.void_fraction,
+                  restart=restart, ddt_alpha=f.ddt_alpha)     # the same for the user's case and the box
     if f.case:                          # the user's own case, copied: the host never writes into it
         source = (scene.folder / f.case).resolve()
         earlier = _set_aside_writes(folder, restart)
@@ -91,8 +93,7 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
         if energy:                      # the gas's properties are the scene's, given once
             props.update({"Cp": f.heat_capacity, "kappa": f.conductivity})
         _mesh(folder, source, str(scene.path))
-        return FluidSolver(folder, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
-                           void_fraction=f.void_fraction, restart=restart, ddt_alpha=f.ddt_alpha).start()
+        return FluidSolver(folder, **solver).start()
     box = scene.domain.box
     boundaries = {face: f.sides for face in ("xlo", "xhi", "ylo", "yhi")}
     inlet = (("inlet_table", [(t, (0.0, 0.0, u)) for t, u in f.inlet_table]) if f.inlet_table
@@ -105,8 +106,7 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
                     dt=scene.time.couple_every * scene.time.dem_step,
                     T0=f.temperature if energy else None, cp=f.heat_capacity, kappa=f.conductivity,
                     T_inlet=f.inlet_temperature or f.temperature, T_walls=sides, nprocs=f.ranks)
-    return FluidSolver(case, drag=f.drag, alpha_min=f.alpha_min, energy=energy, nprocs=f.ranks,
-                       void_fraction=f.void_fraction, restart=restart, ddt_alpha=f.ddt_alpha).start()
+    return FluidSolver(case, **solver).start()
 
 
 def _mesh(case: Path, source: Path, file: str) -> None:
