@@ -18,7 +18,7 @@ from pyhost.exitcodes import UserError, classify  # noqa: F401  (UserError: for 
 from pyhost.signals import stopping
 
 COMMANDS = ("collide", "demo", "run", "pictures", "fluidization", "fit", "paper", "post", "compare",
-            "collisions")
+            "collisions", "dpmfoam")
 
 
 class Parser(argparse.ArgumentParser):

@@ -78,6 +78,19 @@ def restitution_beta(e: float) -> float:
     return math.log(e) / math.sqrt(math.log(e) ** 2 + math.pi**2)
 
 
+def restitution_of_tsuji_alpha(alpha: float) -> float:
+    """The LIGGGHTS restitution e whose Hertz damping is OpenFOAM's spring-slider-dashpot
+    damping of coefficient ``alpha`` [-] (Tsuji et al. 1992; OpenFOAM's
+    PairSpringSliderDashpot and WallSpringSliderDashpot: eta_n = alpha (m* k_n)^(1/2) delta^(1/4),
+    k_n = (4/3) E* R*^(1/2)). With LIGGGHTS' gamma_n above, the two are one law when
+    |beta| = alpha / 5^(1/2); then e = exp(pi beta / (1 - beta^2)^(1/2)), inverting
+    ``restitution_beta``. Both laws give the same restitution at every speed."""
+    if not 0.0 <= alpha < math.sqrt(5.0):
+        raise ValueError(f"the dashpot coefficient alpha must be in [0, 5^(1/2)) (|beta| < 1), got {alpha!r}")
+    beta = -alpha / math.sqrt(5.0)
+    return math.exp(math.pi * beta / math.sqrt(1.0 - beta * beta))
+
+
 @dataclass(frozen=True)
 class DemHertz:
     """The DEM's normal contact law, LIGGGHTS ``model hertz`` (normal_model_hertz.h):
