@@ -6,7 +6,8 @@ on its two ranks; cfdemSolverPisoSTM's, which transports a species, and cfdemSol
 twoSpheresGlowinskiMPI, whose particles the mesh resolves, and voidfractionTest, whose flow is not
 solved, and ErgunTestMPI_cgs, in cgs units, must be refused), and Debian's liggghts-doc tutorials (packing,
 heatTransfer_1 and _2, chute_wear, conveyor, meshGran, movingMeshGran, insert_stream and its
-restart, mesh_tet, hysteresis, cohesion, contactModels, hydrogel_multicontact's default).
+restart, mesh_tet, hysteresis, cohesion, contactModels, hydrogel_multicontact's default), and
+Debian's openfoam-examples DPMFoam tutorial, Goldschmidt, after ``python -m pyhost dpmfoam``.
 
 The tutorials are not part of this repository (their licences are theirs, and fetched
 content is never committed): point ``--cfdem`` at a CFDEMcoupling-PUBLIC checkout; Debian's
@@ -51,6 +52,7 @@ from pyhost.engines.openfoam import run_utility  # noqa: E402
 from plugins.bed import ergun_pressure_drop  # noqa: E402
 
 LIGGGHTS_DOC = Path("/usr/share/doc/liggghts/examples/LIGGGHTS/Tutorials_public")
+OPENFOAM_EXAMPLES = Path("/usr/share/doc/openfoam-examples/examples")
 G = 9.81
 
 
@@ -81,10 +83,10 @@ class Tutorial:
     physics to check on the host's output."""
 
     name: str
-    origin: str                       # "cfdem" or "liggghts"
+    origin: str                       # "cfdem", "liggghts" or "openfoam"
     source: str                       # path inside the origin
     case_dir: str                     # where case.toml goes, inside the copy
-    case_toml: str
+    case_toml: str                    # "": the one the changes wrote (an importer's)
     changes: list = field(default_factory=list)
     native_first: tuple = ()          # (folder inside the copy, script) run with `liggghts -in`
     then: tuple = ()                  # the host's arguments of a second stage (--restart ...), if any
@@ -219,6 +221,41 @@ def packed_bed_checks(w: Path, out: Path) -> list[Check]:
             # temperature) against what the particles gave it; the gas energy equation is solved to
             # its solver's tolerance, not to round-off
             Check("energy balance of particles and gas [-]", total, 0.0, 1e-6, relative=False)]
+
+
+def dpmfoam_import(end: float):
+    """`python -m pyhost dpmfoam . host` on the copy, and what its case.toml asks for: the
+    beads' real material (soda-lime glass), and [time] end."""
+    def apply(w: Path):
+        r = subprocess.run([sys.executable, "-m", "pyhost", "dpmfoam", str(w), str(w / "host")], cwd=ROOT,
+                           capture_output=True, text=True)
+        if r.returncode:
+            raise RuntimeError(f"python -m pyhost dpmfoam failed: {r.stderr.strip()}")
+        toml = (w / "host" / "case.toml").read_text().replace("\n[time]\n", f"\n[time]\nend = {end!r}\n")
+        (w / "host" / "case.toml").write_text(toml + GLASS)
+    return (f"`python -m pyhost dpmfoam . host`; the beads' real material and [time] end = {end} s in host/case.toml",
+            apply)
+
+
+GLASS = "youngs_modulus = 63e9\npoisson_ratio = 0.23\nyield_stress = 500e6\nheat_capacity = 840.0\nconductivity = 1.0\n"
+
+
+def goldschmidt_checks(w: Path, out: Path) -> list[Check]:
+    """DPMFoam's Goldschmidt: every bead kept; the gas crossing each row of cells at the inlet's
+    1.875 m/s superficial (the mean over the row of alpha U_z at the end: continuity through
+    the tutorial's interstitialInletVelocity, which reads the host's fluid fraction); the
+    balance."""
+    last = history(out)[-1]
+    folder = max((p for p in (out / "fluid").iterdir() if re.fullmatch(r"[0-9.e-]+", p.name) and p.name != "0"),
+                 key=lambda p: float(p.name))
+    U = np.asarray(FoamFile(folder / "U")["internalField"], float).reshape(90, 60, 3)[..., 2]
+    alpha = np.asarray(FoamFile(folder / "alpha")["internalField"], float).reshape(90, 60)
+    rows = (alpha * U).mean(axis=1)
+    worst = int(np.argmax(abs(rows - 1.875)))
+    return [Check("beads", float(last["particles"]), 24750, 0, relative=False),
+            Check(f"superficial gas speed, row {worst + 1} of 90, the farthest off [m/s]", float(rows[worst]),
+                  1.875, 0.005),
+            balance_check(out)]
 
 
 def copy_file(source: str, target: str):
@@ -357,6 +394,8 @@ TUTORIALS = [
     Tutorial("hydrogel", "liggghts", "hydrogel_multicontact", ".",          # walls at ${sizeX}, a piston;
              liggghts_scene("in.hydrogel_default", 11.5, types="[1, 2]"),  # its data file's density
              checks=liggghts_checks),
+    Tutorial("Goldschmidt", "openfoam", "lagrangian/DPMFoam/Goldschmidt", "host", "",       # DPMFoam's own
+             changes=[dpmfoam_import(0.05)], checks=goldschmidt_checks),
 ] + [Tutorial(name, "liggghts", folder, ".", liggghts_scene(script, density), checks=liggghts_checks)
      for name, folder, script, density in (          # Debian's, run as they are; density = the script's
          ("packing", "packing", "in.packing", 2500.0),
@@ -374,7 +413,7 @@ TUTORIALS = [
 
 
 def prepare(tut: Tutorial, cfdem: Path | None, work: Path) -> Path:
-    base = cfdem if tut.origin == "cfdem" else LIGGGHTS_DOC
+    base = {"cfdem": cfdem, "liggghts": LIGGGHTS_DOC, "openfoam": OPENFOAM_EXAMPLES}[tut.origin]
     if base is None:
         raise FileNotFoundError("no --cfdem checkout given")
     src = base / tut.source
@@ -385,7 +424,8 @@ def prepare(tut: Tutorial, cfdem: Path | None, work: Path) -> Path:
     shutil.copytree(src, dst)
     for _, apply in tut.changes:
         apply(dst)
-    (dst / tut.case_dir / "case.toml").write_text(tut.case_toml)
+    if tut.case_toml:
+        (dst / tut.case_dir / "case.toml").write_text(tut.case_toml)
     return dst
 
 
