@@ -157,8 +157,9 @@ def render_particles(out: Path) -> Path:
     """The last VTK frame rendered off screen -> out/particles.png: the particles as spheres
     (point sprites above GLYPHS_UP_TO particles) coloured by their temperature change since
     they first appear (``change_scale``). For a fluid run (out/vtk/fluid.pvd) they are drawn over the
-    fluid volume fraction [-] of the same frame: the mid-y slice of the fluid cells (domain box
-    and plenum below it), placed at the back face and viewed from the front (-y), framed on the
+    fluid volume fraction [-] of the same frame: the mid slice of the fluid cells (domain box
+    and plenum below it) across the thinner horizontal axis (y for the host's boxes, x for
+    DPMFoam's Goldschmidt), placed at the back face and viewed from the front, framed on the
     bed (plenum to a little above the highest particle), so a pseudo-2-D bed reads like the
     usual 2-D bed picture."""
     import pyvista
@@ -191,18 +192,29 @@ def render_particles(out: Path) -> Path:
                      scalar_bar_args=dict(bar, title=f"T change [{unit}]\n", position_x=0.86, fmt="%.3g")
                      if has_fluid else {"title": title}, **size)
     if has_fluid:
-        x0, x1, y0, y1, z0, z1 = grid.bounds
-        back = grid.slice(normal="y", origin=grid.center).translate((0, y1 + 0.02 * (y1 - y0) - grid.center[1], 0))
+        b = np.array(grid.bounds).reshape(3, 2)
+        depth = 0 if b[0, 1] - b[0, 0] < b[1, 1] - b[1, 0] else 1    # the thin horizontal axis: seen across
+        across = 1 - depth
+        (x0, x1), (y0, y1), (z0, z1) = b[across], b[depth], b[2]     # x: across the picture, y: depth
+        # seen from -y (the host's boxes) or from +x (x thin): the across axis points right
+        towards = -1.0 if depth == 1 else 1.0                         # where the camera is, along depth
+        back = y1 if depth == 1 else y0
+        shift = np.zeros(3)
+        shift[depth] = back - towards * 0.02 * (y1 - y0) - grid.center[depth]
+        sheet = grid.slice(normal="xy"[depth], origin=grid.center).translate(shift)
         lo = min(np.floor(10 * np.nanmin(grid.cell_data["alpha"])) / 10, 0.9)
-        plotter.add_mesh(back, scalars="alpha", cmap="gray", clim=(lo, 1.0), lighting=False,
+        plotter.add_mesh(sheet, scalars="alpha", cmap="gray", clim=(lo, 1.0), lighting=False,
                          scalar_bar_args=dict(bar, title="fluid fraction [-]\n", position_x=0.04, fmt="%.1f",
                                               n_labels=round(10 * (1 - lo)) + 1))
-        plotter.add_mesh(back.outline(), color="black")
+        plotter.add_mesh(sheet.outline(), color="black")
         top = spheres.bounds[5]
         top = min(z1, top + 0.3 * (top - z0))                # the bed and a little above it
-        centre = np.array([(x0 + x1) / 2, y1, (z0 + top) / 2])
+        centre = np.array([0.0, 0.0, (z0 + top) / 2])
+        centre[across], centre[depth] = (x0 + x1) / 2, back
+        view = np.zeros(3)
+        view[depth] = towards * 10 * (x1 - x0 + top - z0)
         plotter.camera.focal_point = centre
-        plotter.camera.position = centre - [0, 10 * (x1 - x0 + top - z0), 0]
+        plotter.camera.position = centre + view
         plotter.camera.up = (0, 0, 1)
         plotter.enable_parallel_projection()
         width, height = WINDOW_FLUID

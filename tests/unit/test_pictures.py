@@ -24,13 +24,17 @@ def cells():
     return c, np.where(c[:, 2] < 0.02, 0.4, 1.0)
 
 
-def write_run(out, fluid=True):
+def write_run(out, fluid=True, thin_x=False):
+    """``thin_x``: the same bed turned a quarter about z, thin in x (as DPMFoam's Goldschmidt)."""
     centres, alpha = cells()
+    box = BOX
+    x = np.array([[0.01, 0.002, 0.005], [0.02, 0.002, 0.005], [0.03, 0.002, 0.025]])
+    if thin_x:
+        centres, x, box = centres[:, [1, 0, 2]], x[:, [1, 0, 2]], BOX[2:4] + BOX[:2] + BOX[4:]
     history = out / "history.csv"
     history.write_text("time,T_group0,collisions\n0.0,300.0,0\n0.01,300.5,7\n")
-    (out / "scene.json").write_text(json.dumps({"domain": {"box": BOX},
+    (out / "scene.json").write_text(json.dumps({"domain": {"box": box},
                                                 "fluid": {"plenum": PLENUM, "cells": [4, 1, 6]}}))
-    x = np.array([[0.01, 0.002, 0.005], [0.02, 0.002, 0.005], [0.03, 0.002, 0.025]])
     particles = VtkSeries(out / "vtk", "particles")
     if fluid:
         frames = VtkSeries(out / "vtk", "fluid")
@@ -62,9 +66,11 @@ def test_fluid_grid_without_box_and_not_uniform():
         fluid_grid(centres[1:], alpha[1:])
 
 
-@pytest.mark.parametrize("fluid", [True, False])
-def test_particles_png(tmp_path, fluid):
-    write_run(tmp_path, fluid)
+@pytest.mark.parametrize("fluid, thin_x", [(True, False), (False, False), (True, True)])
+def test_particles_png(tmp_path, fluid, thin_x):
+    """The fluid fraction is seen across the bed's thin horizontal side, y or x (thin in x, it
+    was seen edge on before session 39: a strip 4 mm wide)."""
+    write_run(tmp_path, fluid, thin_x)
     r = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     image = np.asarray(Image.open(tmp_path / "particles.png").convert("RGB")).astype(int)
