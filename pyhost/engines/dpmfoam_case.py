@@ -319,7 +319,8 @@ def convert(case: str | Path, out: str | Path, impact_speed: float = 1.0) -> dic
             dst = cfd / _suffixless(rel, cloud.phase)
             dst.parent.mkdir(parents=True, exist_ok=True)
             try:
-                text = (gzip.open(src, "rt") if src.suffix == ".gz" else open(src)).read()
+                with gzip.open(src, "rt") if src.suffix == ".gz" else open(src) as f:
+                    text = f.read()
             except (UnicodeDecodeError, gzip.BadGzipFile):
                 raise DpmfoamError(f"{src}: not a text file (the importer reads OpenFOAM's ascii files)") from None
             dst.write_text(_suffixless(text, cloud.phase))
@@ -363,13 +364,13 @@ def _write_data(path: Path, cloud: Cloud) -> None:
 def _script(cloud: Cloud, dt: float, case: Path) -> str:
     kinds = _types(cloud)
     n = len(kinds)
-    E = " ".join(f"{k.E:g}" for k in kinds)
-    nu = " ".join(f"{k.nu:g}" for k in kinds)
+    E = " ".join(f"{k.E!r}" for k in kinds)
+    nu = " ".join(f"{k.nu!r}" for k in kinds)
 
     def matrix(value):
         rows = []
         for i in range(n):
-            rows.append(" ".join(f"{value(i, j):.10g}" for j in range(n)))
+            rows.append(" ".join(f"{value(i, j)!r}" for j in range(n)))
         return " &\n\t".join(rows)
 
     def of(i, j, what):             # particle-particle: the pair's; particle-wall: the wall's

@@ -90,6 +90,9 @@ def test_goldschmidt_converted(tmp_path):
         [("x", -0.0075), ("x", 0.0075), ("y", -0.075), ("y", 0.075), ("z", 0.0), ("z", 0.45)])
     assert "timestep\t" + repr(done["dt"]) in script
     assert "fix\tgravi all gravity 9.81 vector 0.0 0.0 -1.0" in script
+    rows = script.split("coefficientRestitution peratomtypepair 3 &\n\t")[1].split(" &\n\t")[:3]
+    e = [[float(v) for v in row.split()[:3]] for row in rows]      # to the last digit, both ways round
+    assert e[0] == [cloud.pair.e, cloud.walls["walls"].e, 0.97] and e[1][0] == e[0][1] and e[2][0] == 0.97
     # the gas: the phase's suffix gone everywhere, collheatFoam's names in place
     for f in (out / "CFD").rglob("*"):
         if f.is_file():
