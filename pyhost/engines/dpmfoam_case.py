@@ -34,8 +34,8 @@ What is translated, and how (SI units throughout):
   moves by a hair flips its volume between two cells within one gas step; d(alpha)/dt turns
   that into gas speeds of +-17 m/s (500 beads, 6 ms; the inlet gives 1.875 m/s) that kick the
   beads upward (shifted 0.1 mm off the face, the lattice runs clean with it); in a bubbling
-  bed every bead crossing a face does the same. ``void_fraction = "divided"`` with ``ddt_alpha = true`` keeps both, at about
-  17 times the cost on the whole tutorial;
+  bed every bead crossing a face does the same. ``void_fraction = "divided"`` with
+  ``ddt_alpha = true`` keeps both, at about 4 times the cost on the whole tutorial;
 - the DEM step: the Hertz collision time of two particles at ``impact_speed`` over the
   pair model's ``collisionResolutionSteps`` (DPMFoam sub-cycles to that many steps per
   collision at the cloud's fastest speed), shortened to divide the gas's deltaT.

@@ -359,7 +359,7 @@ class FluidSolver:
         ncells = len(self.cell_volumes)
         if self.void_fraction == "divided" and len(x):
             points = (x[:, None, :] + 0.5 * d[:, None, None] * DIVIDED[None, :, 1:]).reshape(-1, 3)
-            cells = self.locate(points, strict=False)[0].reshape(len(x), -1)
+            cells = self.locate(points, strict=False, point_set=1)[0].reshape(len(x), -1)
             cells = np.where(cells >= 0, cells, cell[:, None])    # a point beyond a curved wall: the centre's
             share = np.broadcast_to(DIVIDED[:, 0], cells.shape)
         else:
@@ -380,14 +380,17 @@ class FluidSolver:
         return k[:, None] * slip - (vp * self.rho)[:, None] * gradp
 
     @_exchange
-    def locate(self, x: np.ndarray, strict: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def locate(self, x: np.ndarray, strict: bool = True,
+               point_set: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Cell of each position (global index over ranks), fluid velocity (m/s) and kinematic
         pressure gradient (m/s^2) there, interpolated as controlDict's
         ``particleInterpolation`` says (default ``cell``). ValueError if a point is outside
-        (``strict``), else cell -1 there."""
+        (``strict``), else cell -1 there. ``point_set``: which set they are (0 the particles'
+        centres, 1 the divided rule's points in them): the solver tries each point's cell of
+        the last request of its set first."""
         x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 3)
         n = len(x)
-        request = np.int32(LOCATE).tobytes() + np.int32(n).tobytes() + x.tobytes()
+        request = np.array([LOCATE, n, point_set], np.int32).tobytes() + x.tobytes()
         for rank in range(self.nprocs):
             self._send(rank, request)
         cell = np.full(n, -1, dtype=np.int64)
