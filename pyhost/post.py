@@ -37,7 +37,7 @@ from pyhost.dumps import DumpError, DumpReader, expand, local_compute
 from pyhost.outdir import write_atomic
 from pyhost.output import VtkSeries
 from pyhost.scene import read_toml
-from pyhost.schema import Material, SceneError, Wall, build
+from pyhost.schema import Material, SceneError, Wall, build, check_types
 from pyhost.walls import FACES
 
 MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
@@ -48,7 +48,7 @@ class PostScene:
     path: Path
     materials: dict                 # name -> Material (real and DEM values, types, temperature)
     types: dict                     # LIGGGHTS atom type -> material index
-    temperature: list               # initial temperature per material [K]; 0: from the dumps
+    temperature: dict               # initial temperature per atom type [K]; 0: from the dumps
     walls: list                     # pyhost.scene.Wall
 
 
@@ -61,15 +61,8 @@ def load_post_scene(path) -> PostScene:
     if not isinstance(data.get("materials"), dict) or not data["materials"]:
         raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
     materials = {name: build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
-    types = {}
-    for k, (name, m) in enumerate(materials.items()):
-        for t in m.types:
-            if not isinstance(t, int) or isinstance(t, bool) or t < 1:
-                raise SceneError(f"{file}: materials.{name}.types: atom types are integers >= 1, got {t!r}")
-            if t in types:
-                raise SceneError(f"{file}: materials.{name}.types: type {t} is also in "
-                                 f"materials.{list(materials)[types[t]]}")
-            types[t] = k
+    names = list(materials)
+    types = {t: names.index(name) for t, name in check_types(materials, file).items()}
     if not types:
         raise SceneError(f"{file}: materials: no material names its LIGGGHTS atom types (types = [1, 2])")
     if not isinstance(data.get("walls", []), list):
@@ -82,7 +75,8 @@ def load_post_scene(path) -> PostScene:
         if bool(wall.fix) == bool(wall.plane):
             raise SceneError(f"{file}: walls[{k}]: give either fix (a LIGGGHTS wall fix id) or plane "
                              f"({', '.join(FACES)})")
-    return PostScene(path, materials, types, [m.temperature for m in materials.values()], walls)
+    return PostScene(path, materials, types, {t: materials[names[k]].temperature_of(t) for t, k in types.items()},
+                     walls)
 
 
 class Particles:
@@ -536,7 +530,7 @@ class Post:
 
     def initial_temperatures(self, known, mat) -> np.ndarray:
         T0 = np.full(len(self.particles.type), np.nan)
-        given = np.array(self.scene.temperature)[mat]
+        given = np.array([self.scene.temperature.get(t, 0.0) for t in self.particles.type[known].tolist()])
         T0[known] = np.where(given > 0, given, self.particles.T0[known])
         missing = known & np.isnan(T0)
         if missing.any():

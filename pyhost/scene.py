@@ -50,7 +50,7 @@ import tomllib
 from pathlib import Path
 
 from plugins.heat import MODELS
-from pyhost.schema import (Dem, Domain, Effects, Fluid, Material, Output, Particles,  # noqa: F401
+from pyhost.schema import (Dem, Domain, Effects, Fluid, Material, Output, Particles, check_types,  # noqa: F401
                            Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
 from pyhost.validate import check_scene
 
@@ -317,15 +317,9 @@ def _script_couple_every(script: Path) -> tuple[int, str] | None:
 
 
 def _types(materials, walls, file):
-    """Script scenes: each material names its atom types, no type twice; walls name a fix."""
-    owner = {}
-    for name, m in materials.items():
-        for t in m.types:
-            if isinstance(t, bool) or not isinstance(t, int) or t < 1:
-                raise SceneError(f"{file}: materials.{name}.types: atom types are integers >= 1, got {t!r}")
-            if t in owner:
-                raise SceneError(f"{file}: materials.{name}.types: type {t} is already made of {owner[t]!r}")
-            owner[t] = name
+    """Script scenes: each material names its atom types, no type twice (a list of temperatures
+    one per type); walls name a fix."""
+    check_types(materials, file)
     for k, w in enumerate(walls):
         if not w.fix or w.plane:
             raise SceneError(f"{file}: walls[{k}]: a script scene names a LIGGGHTS wall by fix = \"ID\" "

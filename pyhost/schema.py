@@ -41,6 +41,11 @@ def _check(value, rule: str) -> str | None:
             return f"must be one of {', '.join(choices)}, or a list of models, got {value!r}"
         if len(set(names)) != len(names):
             return f"names a model twice: {value!r}"
+    if rule == "temperatures":
+        values = value if isinstance(value, list) else [value]
+        if not values or not all(isinstance(T, (int, float)) and not isinstance(T, bool) and math.isfinite(T)
+                                 and T >= 0 for T in values):
+            return f"must be a temperature >= 0 [K], or a list of them (one per type), got {value!r}"
     if rule.startswith("in:") and value not in rule[3:].split(","):
         return f"must be one of {rule[3:].replace(',', ', ')}, got {value!r}"
     return None
@@ -98,8 +103,32 @@ class Material:
     b1: float = spec(">0", 1.1, "mean pressure at first yield / Y [-]")
     b2: float = spec(">0", 2.8, "fully plastic mean pressure / Y [-]")
     types: list = spec(default=[], doc="LIGGGHTS atom types made of this material (script scenes)")
-    temperature: float = spec(">=0", 0.0, "initial temperature of its particles [K] (script scenes); "
-                                           "0 keeps the script's own Temp values")
+    temperature: float | list = spec("temperatures", 0.0, "initial temperature of its particles [K] (script "
+                                                          "scenes), or a list, one per entry of types; 0 keeps "
+                                                          "the script's own Temp values")
+
+    def temperature_of(self, atom_type: int) -> float:
+        """The initial temperature [K] of this material's atoms of that type (0: the script's)."""
+        if isinstance(self.temperature, list):
+            return float(self.temperature[self.types.index(atom_type)])
+        return float(self.temperature)
+
+
+def check_types(materials: dict, file: str) -> dict:
+    """Script scenes and post: each material names its atom types (integers >= 1, no type
+    twice) and, if it gives a list of temperatures, one per type. Returns {type: name}."""
+    owner = {}
+    for name, m in materials.items():
+        for t in m.types:
+            if isinstance(t, bool) or not isinstance(t, int) or t < 1:
+                raise SceneError(f"{file}: materials.{name}.types: atom types are integers >= 1, got {t!r}")
+            if t in owner:
+                raise SceneError(f"{file}: materials.{name}.types: type {t} is already made of {owner[t]!r}")
+            owner[t] = name
+        if isinstance(m.temperature, list) and len(m.temperature) != len(m.types):
+            raise SceneError(f"{file}: materials.{name}.temperature: {len(m.temperature)} temperatures for "
+                             f"{len(m.types)} types {m.types}: give one per type, or one number")
+    return owner
 
 
 @dataclass(frozen=True)
@@ -305,7 +334,7 @@ def build(cls, data, where: str, file: str):
         if dataclasses.is_dataclass(kind):
             values[name] = build(kind, value, key, file)
             continue
-        if kind is float and isinstance(value, int) and not isinstance(value, bool):
+        if float in (kind, *typing.get_args(kind)) and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         if not isinstance(value, kind) or (kind is not bool and isinstance(value, bool)):
             raise SceneError(f"{file}: {key}: must be {getattr(kind, '__name__', str(kind))}, got {value!r}")

@@ -179,8 +179,10 @@ def user_script(scene):
     type_material = np.full(top + 1, -1)
     for k, m in enumerate(scene.materials.values()):
         type_material[m.types] = k
-    T_material = np.array([m.temperature if m.temperature > 0 else np.nan for m in scene.materials.values()])
-    T_of_type = np.where(type_material >= 0, T_material[type_material], np.nan)
+    T_of_type = np.full(top + 1, np.nan)
+    for m in scene.materials.values():
+        for t in m.types:
+            T_of_type[t] = m.temperature_of(t) if m.temperature_of(t) > 0 else np.nan
 
     told = set()
 

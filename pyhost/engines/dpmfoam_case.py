@@ -292,9 +292,13 @@ def _suffixless(text: str, phase: str) -> str:
     return re.sub(rf"(?<=[A-Za-z0-9_)])\.{re.escape(phase)}\b", "", text) if phase else text
 
 
-def convert(case: str | Path, out: str | Path, impact_speed: float = 1.0) -> dict:
+def convert(case: str | Path, out: str | Path, impact_speed: float = 1.0, hot_below: float | None = None,
+            temperatures: tuple[float, float] = (400.0, 300.0)) -> dict:
     """Write ``out`` (CFD/, DEM/in.liggghts, DEM/particles.data, case.toml) from the DPMFoam
-    ``case``; returns what was chosen (for the command's report). The case is only read."""
+    ``case``; returns what was chosen (for the command's report). The case is only read.
+    DPMFoam's particles have no temperature: all start at ``temperatures[1]`` [K], or with
+    ``hot_below`` [m] those whose centre is below that height z at ``temperatures[0]``: atom
+    type 1 (hot) and 2 (cold), one material with a temperature per type."""
     case, out = Path(case), Path(out)
     cloud = read_cloud(case)
     control = _read(case / "system" / "controlDict")
@@ -306,6 +310,14 @@ def convert(case: str | Path, out: str | Path, impact_speed: float = 1.0) -> dic
         k = int(np.flatnonzero(~inside)[0])
         raise DpmfoamError(f"{case}/constant: particle {k + 1} at {cloud.positions[k].tolist()} reaches outside the "
                            f"box {cloud.lo.tolist()} - {cloud.hi.tolist()}")
+
+    if hot_below is not None and not cloud.lo[2] < hot_below < cloud.hi[2]:
+        raise DpmfoamError(f"hot_below: {hot_below!r} m is not inside the box's z range "
+                           f"{cloud.lo[2]!r} - {cloud.hi[2]!r} m")
+    if not all(math.isfinite(T) and T > 0 for T in temperatures):
+        raise DpmfoamError(f"temperatures: must be positive [K], got {tuple(temperatures)!r}")
+    kind = (np.where(cloud.positions[:, 2] < hot_below, 1, 2) if hot_below is not None
+            else np.ones(len(cloud.positions), int))
 
     cfd, dem = out / "CFD", out / "DEM"
     if out.exists():
@@ -330,39 +342,41 @@ def convert(case: str | Path, out: str | Path, impact_speed: float = 1.0) -> dic
     block["boundary"] = [(name, {**entry, "type": "patch"} if name in retyped else entry) for name, entry in boundary]
 
     dem.mkdir(parents=True)
-    _write_data(dem / "particles.data", cloud)
-    (dem / "in.liggghts").write_text(_script(cloud, dt, case))
-    (out / "case.toml").write_text(_scene(cloud, every, case))
+    beads = int(kind.max())             # the particles' atom types: 1, or 1 (hot) and 2 (cold)
+    _write_data(dem / "particles.data", cloud, kind)
+    (dem / "in.liggghts").write_text(_script(cloud, dt, case, beads))
+    (out / "case.toml").write_text(_scene(cloud, every, case, beads, temperatures))
     return dict(particles=len(cloud.positions), dt=dt, couple_every=every, deltaT=deltaT,
                 e_pair=cloud.pair.e, walls={p: c.e for p, c in cloud.walls.items()}, retyped=retyped,
-                drag=cloud.drag)
+                drag=cloud.drag, hot=int(np.sum(kind == 1)) if beads == 2 else 0)
 
 
-def _types(cloud: Cloud) -> list[Contact]:
-    """LIGGGHTS' atom types: 1 the particles, then one per distinct wall contact."""
-    kinds = [cloud.pair]
+def _types(cloud: Cloud, beads: int) -> list[Contact]:
+    """LIGGGHTS' atom types: the particles' (``beads`` of them, one contact), then one per
+    distinct wall contact."""
+    kinds = [cloud.pair] * beads
     for c in cloud.walls.values():
-        if c not in kinds[1:]:
+        if c not in kinds[beads:]:
             kinds.append(c)
     return kinds
 
 
-def _write_data(path: Path, cloud: Cloud) -> None:
+def _write_data(path: Path, cloud: Cloud, kind: np.ndarray) -> None:
     n = len(cloud.positions)
     lines = ["LIGGGHTS data file: the particles of a DPMFoam case's manualInjection (pyhost dpmfoam)", "",
-             f"{n} atoms", f"{len(_types(cloud))} atom types", ""]
+             f"{n} atoms", f"{len(_types(cloud, int(kind.max())))} atom types", ""]
     lines += [f"{lo!r} {hi!r} {a}lo {a}hi" for lo, hi, a in zip(cloud.lo.tolist(), cloud.hi.tolist(), "xyz")]
     lines += ["", "Atoms", ""]
-    lines += [f"{k + 1} 1 {cloud.diameter!r} {cloud.density!r} {x!r} {y!r} {z!r}"
-              for k, (x, y, z) in enumerate(cloud.positions.tolist())]
+    lines += [f"{k + 1} {t} {cloud.diameter!r} {cloud.density!r} {x!r} {y!r} {z!r}"
+              for k, (t, (x, y, z)) in enumerate(zip(kind.tolist(), cloud.positions.tolist()))]
     if np.any(cloud.velocity):
         u = " ".join(repr(c) for c in cloud.velocity.tolist())
         lines += ["", "Velocities", ""] + [f"{k + 1} {u} 0 0 0" for k in range(n)]
     path.write_text("\n".join(lines) + "\n")
 
 
-def _script(cloud: Cloud, dt: float, case: Path) -> str:
-    kinds = _types(cloud)
+def _script(cloud: Cloud, dt: float, case: Path, beads: int) -> str:
+    kinds = _types(cloud, beads)
     n = len(kinds)
     E = " ".join(f"{k.E!r}" for k in kinds)
     nu = " ".join(f"{k.nu!r}" for k in kinds)
@@ -375,7 +389,7 @@ def _script(cloud: Cloud, dt: float, case: Path) -> str:
 
     def of(i, j, what):             # particle-particle: the pair's; particle-wall: the wall's
         k = max(i, j)
-        return getattr(kinds[k] if min(i, j) == 0 else cloud.pair, what)
+        return getattr(kinds[k] if min(i, j) < beads else cloud.pair, what)
 
     g = float(np.linalg.norm(cloud.gravity))
     gravity = (f"fix\tgravi all gravity {g!r} vector " + " ".join(f"{c!r}" for c in (cloud.gravity / g).tolist())
@@ -386,11 +400,12 @@ def _script(cloud: Cloud, dt: float, case: Path) -> str:
         axis, side = face[0], face[1:]
         at = float((cloud.lo if side == "lo" else cloud.hi)["xyz".index(axis)])
         walls.append(f"fix\twall_{patch}_{face} all wall/gran model hertz tangential history primitive type "
-                     f"{kinds.index(cloud.walls[patch]) + 1} {axis}plane {at!r}")
-    walls_said = ", ".join(f"{k + 1} walls of e = {c.e:.4f}, mu = {c.mu:g}" for k, c in enumerate(kinds) if k)
+                     f"{kinds.index(cloud.walls[patch], beads) + 1} {axis}plane {at!r}")
+    walls_said = ", ".join(f"{k + 1} walls of e = {c.e:.4f}, mu = {c.mu:g}" for k, c in enumerate(kinds)
+                           if k >= beads)
     return f"""# The particles of the DPMFoam case {case} (constant/kinematicCloudProperties), written by
 # 'python -m pyhost dpmfoam' (pyhost/engines/dpmfoam_case.py says what maps to what).
-# Atom types: 1 the particles; {walls_said}.
+# Atom types: {"1 the particles" if beads == 1 else "1 the hot particles, 2 the cold ones"}; {walls_said}.
 
 atom_style\tgranular
 atom_modify\tmap array
@@ -427,7 +442,9 @@ run\t0
 """
 
 
-def _scene(cloud: Cloud, every: int, case: Path) -> str:
+def _scene(cloud: Cloud, every: int, case: Path, beads: int, temperatures) -> str:
+    T_hot, T_cold = (float(T) for T in temperatures)
+    types, T = ("[1]", f"{T_cold!r}") if beads == 1 else ("[1, 2]", f"[{T_hot!r}, {T_cold!r}]")
     return f"""# The DPMFoam case
 #   {case}
 # as written by 'python -m pyhost dpmfoam'. DPMFoam's particles have no temperature and no
@@ -450,9 +467,9 @@ ddt_alpha = false          # DPMFoam solves d(alpha)/dt: pyhost/engines/dpmfoam_
 couple_every = {every}           # DEM steps per gas step (the case's deltaT)
 
 [materials.particles]
-types = [1]
+types = {types}
 density = {cloud.density!r:<14s} # kg/m^3, the case's rho0
-temperature = 300.0        # K: DPMFoam's particles have none
+temperature = {T}     # K, per type: DPMFoam's particles have none
 # the real material, for the contact heat model (DPMFoam's youngsModulus {cloud.pair.E:g} Pa
 # is the DEM's softened one):
 # youngs_modulus =         # Pa

@@ -24,7 +24,9 @@ BEADS, END, G = 2500, 0.006, 9.81
 
 
 def test_imported_goldschmidt_runs_with_its_inlet_and_falls_as_in_dpmfoam(tmp_path):
-    """The host's run of the imported tutorial: every bead kept inside the box; the gas
+    """The host's run of the imported tutorial (``--hot-below 0.012``: its four lowest layers
+    start at 400 K, the rest at 300 K, a temperature per atom type): every bead kept inside
+    the box; the gas
     entering through the tutorial's interstitialInletVelocity (1.875 m/s superficial) carries
     the same superficial speed through each of the three lowest rows of cells, beads or none,
     within 0.5 % (continuity; the condition reads the host's fluid fraction); the balance
@@ -35,15 +37,21 @@ def test_imported_goldschmidt_runs_with_its_inlet_and_falls_as_in_dpmfoam(tmp_pa
     departs from its own fluxes and the two differ by 40 %: docs/dpmfoam.md)."""
     case = tutorial(tmp_path / "Goldschmidt", BEADS, END)
     out = tmp_path / "host"
-    r = subprocess.run([sys.executable, "-m", "pyhost", "dpmfoam", str(case), str(out)], capture_output=True,
-                       text=True, cwd=ROOT)
+    r = subprocess.run([sys.executable, "-m", "pyhost", "dpmfoam", str(case), str(out), "--hot-below", "0.012"],
+                       capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     toml = (out / "case.toml").read_text() + GLASS + f"\n[output]\nevery = {END!r}\npictures = false\n"
     (out / "case.toml").write_text(toml.replace("\n[time]\n", f"\n[time]\nend = {END!r}\n"))
     r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(out)], capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
 
-    frame = meshio.read(sorted((out / "output" / "vtk").glob("particles_*.vtu"))[-1])
+    frames = sorted((out / "output" / "vtk").glob("particles_*.vtu"))
+    first = meshio.read(frames[0])      # the hot type at 400 K, the cold at 300 K, as the host set them
+    hot = first.points[:, 2] < 0.012
+    assert hot.sum() == 1000                                            # the four lowest layers
+    T = first.point_data["temperature"]
+    assert np.all(T[hot] == 400.0) and np.all(T[~hot] == 300.0)
+    frame = meshio.read(frames[-1])
     x, r_, v = frame.points, frame.point_data["radius"], frame.point_data["velocity"]
     assert len(x) == BEADS
     lo, hi = np.array([-0.0075, -0.075, 0.0]), np.array([0.0075, 0.075, 0.45])

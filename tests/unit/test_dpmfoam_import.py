@@ -104,6 +104,32 @@ def test_goldschmidt_converted(tmp_path):
         convert(GOLDSCHMIDT, out)
 
 
+def test_hot_beads_are_a_type_of_their_own(tmp_path):
+    """``hot_below``: the beads below it are atom type 1, the others 2, one material with a
+    temperature per type; the walls' types follow."""
+    out = tmp_path / "gold"
+    done = convert(GOLDSCHMIDT, out, hot_below=0.1445, temperatures=(450.0, 290.0))
+    cloud = read_cloud(GOLDSCHMIDT)
+    rows = np.array([ln.split() for ln in (out / "DEM" / "particles.data").read_text().split("Atoms")[1].splitlines()
+                     if ln.strip()], float)
+    assert np.array_equal(rows[:, 1] == 1, cloud.positions[:, 2] < 0.1445) and done["hot"] == 12000
+    script = (out / "DEM" / "in.liggghts").read_text()
+    assert re.findall(r"primitive type (\d)", script) == ["4", "4", "3", "3", "3", "3"]
+    (out / "case.toml").write_text((out / "case.toml").read_text() + MATERIAL)
+    particles = load_scene(out / "case.toml").materials["particles"]
+    assert particles.types == [1, 2] and (particles.temperature_of(1), particles.temperature_of(2)) == (450.0, 290.0)
+    with pytest.raises(DpmfoamError, match="hot_below: 0.5 m is not inside"):
+        convert(GOLDSCHMIDT, tmp_path / "other", hot_below=0.5)
+
+
+def test_a_temperature_per_type_needs_one_per_type(tmp_path):
+    convert(GOLDSCHMIDT, tmp_path / "gold", hot_below=0.1445)
+    toml = tmp_path / "gold" / "case.toml"
+    toml.write_text(toml.read_text().replace("temperature = [400.0, 300.0]", "temperature = [400.0]") + MATERIAL)
+    with pytest.raises(SceneError, match=r"materials\.particles\.temperature: 1 temperatures for 2 types"):
+        load_scene(toml)
+
+
 def test_converted_case_needs_the_real_material(tmp_path):
     out = tmp_path / "gold"
     convert(GOLDSCHMIDT, out)
