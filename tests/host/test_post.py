@@ -157,11 +157,17 @@ def test_a_failure_keeps_what_came_before_and_says_incomplete(tmp_path):
      "unknown material 'wood'"),
     (lambda s: s.replace("types = [1, 2]", "types = [1, 2]\ntemperature = -3"), "temperature: must be"),
     (lambda s: s.replace("density", "densty"), "densty: unknown key"),
+    (lambda s: s.replace("types = [1, 2]", "types = [1, 2]\ntemperature = [300.0]"), "1 temperatures for 2 types"),
 ])
 def test_scene_errors_name_the_key(tmp_path, change, problem):
     (tmp_path / "s.toml").write_text(change(GLASS))
     with pytest.raises(SceneError, match=problem):
         load_post_scene(tmp_path / "s.toml")
+
+
+def test_a_temperature_per_type(tmp_path):
+    (tmp_path / "s.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1, 2]\ntemperature = [400, 300.5]"))
+    assert load_post_scene(tmp_path / "s.toml").temperature == {1: 400.0, 2: 300.5}
 
 
 def test_an_atom_type_without_material_is_an_error(tmp_path):
