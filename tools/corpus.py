@@ -225,19 +225,11 @@ def packed_bed_checks(w: Path, out: Path) -> list[Check]:
 
 def dpmfoam_import(end: float):
     """`python -m pyhost dpmfoam . host` on the copy, and what its case.toml asks for: the
-    beads' real material (soda-lime glass), and [time] end."""
-    def apply(w: Path):
-        r = subprocess.run([sys.executable, "-m", "pyhost", "dpmfoam", str(w), str(w / "host")], cwd=ROOT,
-                           capture_output=True, text=True)
-        if r.returncode:
-            raise RuntimeError(f"python -m pyhost dpmfoam failed: {r.stderr.strip()}")
-        toml = (w / "host" / "case.toml").read_text().replace("\n[time]\n", f"\n[time]\nend = {end!r}\n")
-        (w / "host" / "case.toml").write_text(toml + GLASS)
+    beads' real material (soda-lime glass), and [time] end (tools/dpmfoam_as_is.py)."""
+    from dpmfoam_as_is import import_case
+
     return (f"`python -m pyhost dpmfoam . host`; the beads' real material and [time] end = {end} s in host/case.toml",
-            apply)
-
-
-GLASS = "youngs_modulus = 63e9\npoisson_ratio = 0.23\nyield_stress = 500e6\nheat_capacity = 840.0\nconductivity = 1.0\n"
+            lambda w: import_case(w, w / "host", end, frames=True))
 
 
 def goldschmidt_checks(w: Path, out: Path) -> list[Check]:

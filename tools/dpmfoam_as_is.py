@@ -64,10 +64,23 @@ def rows(folder: Path, u: str, alpha: str, shape=(90, 60)) -> list[tuple[float, 
     return [(a[r].mean(), U[r].mean(), (a[r] * U[r]).mean()) for r in range(3)]
 
 
-def host(case: Path, out: Path, end: float) -> tuple[float, float, list]:
-    subprocess.run([sys.executable, "-m", "pyhost", "dpmfoam", str(case), str(out)], check=True, cwd=ROOT)
-    toml = (out / "case.toml").read_text() + GLASS + f"\n[output]\nevery = {end!r}\npictures = false\n"
+def import_case(case: Path, out: Path, end: float, *options: str, frames: bool = False) -> Path:
+    """``python -m pyhost dpmfoam CASE OUT [options]``, then what its case.toml asks a user
+    for: the beads' real material (soda-lime glass), and [time] end = ``end`` [s]; unless
+    ``frames``, one output frame at the end and no pictures. RuntimeError with the command's
+    words if it fails."""
+    r = subprocess.run([sys.executable, "-m", "pyhost", "dpmfoam", str(case), str(out), *options], cwd=ROOT,
+                       capture_output=True, text=True)
+    if r.returncode:
+        raise RuntimeError(f"python -m pyhost dpmfoam failed: {r.stderr.strip()}")
+    toml = (out / "case.toml").read_text() + GLASS
+    toml += "" if frames else f"\n[output]\nevery = {end!r}\npictures = false\n"
     (out / "case.toml").write_text(toml.replace("\n[time]\n", f"\n[time]\nend = {end!r}\n"))
+    return out
+
+
+def host(case: Path, out: Path, end: float) -> tuple[float, float, list]:
+    import_case(case, out, end)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-m", "pyhost", "run", str(out)], check=True, cwd=ROOT,
                    stdout=subprocess.DEVNULL)

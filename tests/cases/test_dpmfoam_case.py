@@ -18,7 +18,7 @@ from foamlib import FoamFile
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
-from dpmfoam_as_is import GLASS, dpmfoam, tutorial  # noqa: E402
+from dpmfoam_as_is import dpmfoam, import_case, tutorial  # noqa: E402
 
 BEADS, END, G = 2500, 0.006, 9.81
 
@@ -36,12 +36,7 @@ def test_imported_goldschmidt_runs_with_its_inlet_and_falls_as_in_dpmfoam(tmp_pa
     (4.6 %; with 500 beads, a bed one cell high, DPMFoam's cell gas velocity at the bed's edge
     departs from its own fluxes and the two differ by 40 %: docs/dpmfoam.md)."""
     case = tutorial(tmp_path / "Goldschmidt", BEADS, END)
-    out = tmp_path / "host"
-    r = subprocess.run([sys.executable, "-m", "pyhost", "dpmfoam", str(case), str(out), "--hot-below", "0.012"],
-                       capture_output=True, text=True, cwd=ROOT)
-    assert r.returncode == 0, r.stderr
-    toml = (out / "case.toml").read_text() + GLASS + f"\n[output]\nevery = {END!r}\npictures = false\n"
-    (out / "case.toml").write_text(toml.replace("\n[time]\n", f"\n[time]\nend = {END!r}\n"))
+    out = import_case(case, tmp_path / "host", END, "--hot-below", "0.012")
     r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(out)], capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
 
