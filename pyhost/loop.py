@@ -71,10 +71,11 @@ class HostWall:
 @dataclass(frozen=True)
 class Known:
     """What the host knows of each particle before LIGGGHTS holds it, by atom id (a box scene:
-    the host placed every particle) or by atom type (a user's script: by its material): the
-    group of the history's T_group columns (index into ``names``; -1: none) and the
-    starting temperature [K] (NaN: keep the value LIGGGHTS holds). Tables are indexed by the
-    key; a key beyond a table takes its last entry."""
+    the host placed every particle) or by atom type (a user's script): the group of the
+    history's T_group columns (index into ``names``; -1: none; a script's groups are its
+    materials, a material with a temperature per type one group per type) and the starting
+    temperature [K] (NaN: keep the value LIGGGHTS holds). Tables are indexed by the key; a key
+    beyond a table takes its last entry."""
 
     by: str                 # "id" or "type"
     group: np.ndarray

@@ -104,8 +104,9 @@ class Material:
     b2: float = spec(">0", 2.8, "fully plastic mean pressure / Y [-]")
     types: list = spec(default=[], doc="LIGGGHTS atom types made of this material (script scenes)")
     temperature: float | list = spec("temperatures", 0.0, "initial temperature of its particles [K] (script "
-                                                          "scenes), or a list, one per entry of types; 0 keeps "
-                                                          "the script's own Temp values")
+                                                          "scenes), or a list, one per entry of types (each "
+                                                          "type then a temperature group of its own in "
+                                                          "history.csv); 0 keeps the script's own Temp values")
 
     def temperature_of(self, atom_type: int) -> float:
         """The initial temperature [K] of this material's atoms of that type (0: the script's)."""

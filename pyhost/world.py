@@ -164,12 +164,14 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
 
 def user_script(scene):
     """How the host sees the particles of a user's script: each atom type's material from
-    [materials.NAME] types, groups = materials, walls = the scene's [[walls]] (by fix id) and
-    every other wall/gran fix of the script as an adiabatic wall."""
+    [materials.NAME] types; the history's temperature groups: one per material, or one per
+    atom type of a material that gives a temperature per type (``NAME (type T)``: hot and
+    cold beads of one material apart); walls = the scene's [[walls]] (by fix id) and every
+    other wall/gran fix of the script as an adiabatic wall."""
     from pyhost.loop import HostWall, Known
     from pyhost.scene import SceneError
 
-    names = list(scene.materials)
+    materials = list(scene.materials)
     used = {w.material for w in scene.walls}
     for name, m in scene.materials.items():
         if not m.types and name not in used:
@@ -180,9 +182,14 @@ def user_script(scene):
     for k, m in enumerate(scene.materials.values()):
         type_material[m.types] = k
     T_of_type = np.full(top + 1, np.nan)
-    for m in scene.materials.values():
+    type_group, names = np.full(top + 1, -1), []
+    for name, m in scene.materials.items():
         for t in m.types:
             T_of_type[t] = m.temperature_of(t) if m.temperature_of(t) > 0 else np.nan
+        apart = isinstance(m.temperature, list)
+        for label, types in ([(f"{name} (type {t})", [t]) for t in m.types] if apart else [(name, m.types)]):
+            type_group[types] = len(names)
+            names.append(label)
 
     told = set()
 
@@ -193,7 +200,7 @@ def user_script(scene):
             if w.fix not in known:
                 raise SceneError(f"{scene.path}: walls[{k}].fix: the script has no fix wall/gran {w.fix!r} "
                                  f"before its first run; its walls: {', '.join(known) or 'none'}")
-            named[w.fix] = (names.index(w.material), w.temperature if w.temperature > 0 else np.nan)
+            named[w.fix] = (materials.index(w.material), w.temperature if w.temperature > 0 else np.nan)
         for fix in known:
             if fix not in named and fix not in told:
                 print(f"LIGGGHTS wall {fix!r} has no [[walls]] entry: adiabatic for collision heat")
@@ -201,7 +208,7 @@ def user_script(scene):
         return [HostWall(f, *named.get(f, (-1, np.nan)), mesh=k)
                 for f, wall in known.items() for k in range(max(len(wall.meshes), 1))]
 
-    return dict(type_material=type_material, known=Known("type", type_material, T_of_type, tuple(names)),
+    return dict(type_material=type_material, known=Known("type", type_group, T_of_type, tuple(names)),
                 walls_of=walls_of)
 
 

@@ -4,6 +4,7 @@ file cut to its first 2,500 beads (its ten lowest layers; the whole tutorial tak
 about 2 min per 6 ms), 6 ms from rest, engines for real. The beads of its 3 mm lattice (2.5 mm
 beads) touch nothing until the lowest layer, 0.25 mm above the floor, lands after about 8 ms:
 until then each falls against the drag of the gas rising through the lattice."""
+import csv
 import json
 import shutil
 import subprocess
@@ -25,7 +26,8 @@ BEADS, END, G = 2500, 0.006, 9.81
 
 def test_imported_goldschmidt_runs_with_its_inlet_and_falls_as_in_dpmfoam(tmp_path):
     """The host's run of the imported tutorial (``--hot-below 0.012``: its four lowest layers
-    start at 400 K, the rest at 300 K, a temperature per atom type): every bead kept inside
+    start at 400 K, the rest at 300 K, a temperature per atom type, each type a temperature group
+    of the history): every bead kept inside
     the box; the gas
     entering through the tutorial's interstitialInletVelocity (1.875 m/s superficial) carries
     the same superficial speed through each of the three lowest rows of cells, beads or none,
@@ -46,6 +48,9 @@ def test_imported_goldschmidt_runs_with_its_inlet_and_falls_as_in_dpmfoam(tmp_pa
     assert hot.sum() == 1000                                            # the four lowest layers
     T = first.point_data["temperature"]
     assert np.all(T[hot] == 400.0) and np.all(T[~hot] == 300.0)
+    with open(out / "output" / "history.csv") as f:      # one group per type: the hot and the cold beads apart
+        start = next(csv.DictReader(f))
+    assert float(start["T_group0"]) == pytest.approx(400.0, abs=1e-9) and float(start["T_group1"]) == pytest.approx(300.0, abs=1e-9)
     frame = meshio.read(frames[-1])
     x, r_, v = frame.points, frame.point_data["radius"], frame.point_data["velocity"]
     assert len(x) == BEADS
@@ -66,3 +71,4 @@ def test_imported_goldschmidt_runs_with_its_inlet_and_falls_as_in_dpmfoam(tmp_pa
     assert -0.8 * G * END < theirs < -0.2 * G * END and -0.8 * G * END < vz < -0.2 * G * END
     summary = json.loads((out / "output" / "summary.json").read_text())
     assert abs(summary["energy_balance_error"]) < 1e-12
+    assert summary["groups"] == ["particles (type 1)", "particles (type 2)"]

@@ -16,6 +16,7 @@ from plugins.dem.hertz import DemHertz, effective_modulus, hertz_collision_time,
 from pyhost.engines.dpmfoam_case import DpmfoamError, convert, read_cloud
 from pyhost.schema import SceneError
 from pyhost.scene import load_scene
+from pyhost.world import user_script
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
 from dpmfoam_as_is import GLASS as MATERIAL  # noqa: E402  (the five real-material keys a user adds)
@@ -116,6 +117,8 @@ def test_hot_beads_are_a_type_of_their_own(tmp_path):
     (out / "case.toml").write_text((out / "case.toml").read_text() + MATERIAL)
     particles = load_scene(out / "case.toml").materials["particles"]
     assert particles.types == [1, 2] and (particles.temperature_of(1), particles.temperature_of(2)) == (450.0, 290.0)
+    known = user_script(load_scene(out / "case.toml"))["known"]      # the history's groups: hot and cold apart
+    assert known.names == ("particles (type 1)", "particles (type 2)") and list(known.group[1:]) == [0, 1]
     with pytest.raises(DpmfoamError, match="hot_below: 0.5 m is not inside"):
         convert(GOLDSCHMIDT, tmp_path / "other", hot_below=0.5)
 
