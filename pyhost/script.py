@@ -245,6 +245,21 @@ def parse_run(cmd: Command) -> RunCommand:
     return RunCommand(words[1], upto)
 
 
+def output_files(cmd: Command) -> list[str]:
+    """The files a command makes LIGGGHTS open without making their folder, as the script
+    names them (relative to where the script runs; ``$`` variables unresolved): a fix's
+    ``file`` or ``append`` keyword (fix print, ave/time, ...), restart's, write_data's and
+    log's. (dump, write_dump and write_restart make theirs: LIGGGHTS' dump.cpp and
+    write_restart.cpp.)"""
+    w = cmd.words
+    at = {"write_data": [1], "log": [1]}.get(w[0], [])
+    if w[0] == "restart" and len(w) > 2 and w[1] != "0":
+        at = [2, 3]
+    if w[0] == "fix":
+        at = [k + 1 for k in range(4, len(w)) if w[k] in ("file", "append")]
+    return [w[k] for k in at if k < len(w)]
+
+
 @dataclass(frozen=True)
 class GranWall:
     """A ``fix ID group wall/gran ...``: a primitive wall (``primitive`` = (kind, numbers),

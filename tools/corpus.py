@@ -95,11 +95,6 @@ class Tutorial:
     ranks: int = 1                    # > 1: the native stage and the host under mpirun (its processors line kept)
 
 
-def mkdir(*parts):
-    return (f"create {'/'.join(parts)} (the tutorial's scripts write into it; CFDEM's run "
-            "functions create it)", lambda w: (w.joinpath(*parts)).mkdir(parents=True, exist_ok=True))
-
-
 def drop_line(script: str, pattern: str, why: str):
     def apply(w: Path):
         p = w / script
@@ -334,38 +329,33 @@ def liggghts_scene(script: str, density: float, *, cp: float = 840.0, T: float =
 
 TUTORIALS = [
     Tutorial("settlingTestMPI", "cfdem", "tutorials/cfdemSolverPiso/settlingTestMPI", "CFD",
-             cfdem_scene(3000.0),
-             changes=[mkdir("DEM", "post")], checks=settling_checks),
+             cfdem_scene(3000.0), checks=settling_checks),     # DEM/post: the host makes it
     Tutorial("ErgunTestMPI", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI", "CFD",
              cfdem_scene(2000.0),
-             changes=[mkdir("DEM", "post", "restart"),
-                      drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1")],
+             changes=[drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1")],
              native_first=("DEM", "in.liggghts_init"), checks=ergun_checks),
     Tutorial("ErgunTestMPI_np4", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI", "CFD",
-             cfdem_scene(2000.0), changes=[mkdir("DEM", "post", "restart")],          # as it is, on its 4 ranks
+             cfdem_scene(2000.0),          # as it is, on its 4 ranks
              native_first=("DEM", "in.liggghts_init"), ranks=4, checks=ergun_checks),
     Tutorial("ErgunTestMPI_restart", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI_restart", "CFD",
              cfdem_scene(2000.0) + "\n[output]\ncheckpoint = 0.01\npictures = false\n",
-             changes=[mkdir("DEM", "post", "restart"),
-                      drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1"),
+             changes=[drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1"),
                       copy_file("CFD/system/controlDict_run", "CFD/system/controlDict"),
                       copy_file("CFD/constant/couplingProperties_run", "CFD/constant/couplingProperties")],
              native_first=("DEM", "in.liggghts_init"), then=("--restart", "--extend", "0.05"),
              checks=ergun_restart_checks),
     Tutorial("periodicChannel", "cfdem", "tutorials/cfdemSolverPiso/periodicChannel", "CFD",
              cfdem_scene(2000.0, script="in.liggghts_resume"),
-             changes=[mkdir("DEM", "post", "restart"),
-                      drop_line("DEM/in.liggghts_resume", "processors", "it asks for 4 ranks; the host runs on 1")],
+             changes=[drop_line("DEM/in.liggghts_resume", "processors", "it asks for 4 ranks; the host runs on 1")],
              native_first=("DEM", "in.liggghts_init"), checks=periodic_checks),
     Tutorial("packedBedTemp", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),    # its LaEuScalarTemp: li_mason
-             changes=[mkdir("DEM", "post", "restart"),
-                      drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
+             changes=[drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
                       drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks")],
              native_first=("DEM", "in.liggghts_init"), checks=packed_bed_checks),
     Tutorial("packedBedTemp_np2", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),   # as it is, on its 2 ranks
-             changes=[mkdir("DEM", "post", "restart")], native_first=("DEM", "in.liggghts_init"), ranks=2,
+             native_first=("DEM", "in.liggghts_init"), ranks=2,
              checks=packed_bed_checks),
     Tutorial("packedBedTempSTM", "cfdem", "tutorials/cfdemSolverPisoSTM/packedBedTemp", "CFD",   # species C
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),

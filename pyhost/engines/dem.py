@@ -28,7 +28,7 @@ from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
 from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_snapshot, local_values, put_by_id, set_random_states, write_local)
-from pyhost.script import Command, ScriptError, ScriptInfo
+from pyhost.script import Command, ScriptError, ScriptInfo, output_files
 
 FLUID_FIX = "collheat_fluid"
 HEAT_GRAN_WINDOW = 200
@@ -76,8 +76,20 @@ class Dem:
         self.lmp.close()
 
     # -- the script -----------------------------------------------------------------
+    def make_folders(self, cmd: Command) -> None:
+        """The folder of each file the command opens, made if missing: LIGGGHTS refuses a fix
+        print into a folder nobody made ('Cannot open fix print file'), as CFDEM's
+        settlingTestMPI does into DEM/post, which CFDEM's repository does not have."""
+        for name in output_files(cmd):
+            folder = Path(name).parent
+            if "$" not in str(folder) and not folder.is_dir():
+                folder.mkdir(parents=True)
+                self.log(f"made the folder {folder.resolve()} for {name} ({cmd.where()}): LIGGGHTS does not make it")
+
     def command(self, cmd: Command) -> None:
-        """Run one script command; a refusal names the script's file and line."""
+        """Run one script command (its output folders made first); a refusal names the
+        script's file and line."""
+        self.make_folders(cmd)
         try:
             self._raw(cmd.text)
         except LiggghtsError as exc:
@@ -89,6 +101,8 @@ class Dem:
         """The script's commands up to its next ``run`` (none of them a run), in order. A serial
         run tries them together first in one forked copy (each is otherwise tried alone: see
         ``Liggghts.try_ahead``); a refusal names the script's file and line."""
+        for cmd in cmds:
+            self.make_folders(cmd)
         if self.link is None:
             self.lmp.try_ahead([c.text for c in cmds])
         for cmd in cmds:

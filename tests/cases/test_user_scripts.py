@@ -197,9 +197,14 @@ def test_debian_restart_with_reset_timestep_before_its_first_run_runs_unchanged(
 def silo(tmp_path_factory):
     case = tmp_path_factory.mktemp("silo") / "silo-heat"
     shutil.copytree(ROOT / "cases" / "silo-heat", case, ignore=shutil.ignore_patterns("output", "post", "log.*"))
-    (case / "post").mkdir()
+    script = case / "in.liggghts"       # a fix print into a folder nobody made (settlingTestMPI's DEM/post)
+    text = script.read_text()
+    first_run = text.index("\nrun")
+    script.write_text(text[:first_run] + '\nfix told all print 1000 "poured" file printed/by/fix.txt screen no'
+                      + text[first_run:])
     r, summary = run(case, "--test")
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert f"made the folder {case / 'printed' / 'by'}" in r.stdout and (case / "printed" / "by" / "fix.txt").is_file()
     return case, summary
 
 

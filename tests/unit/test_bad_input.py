@@ -99,3 +99,24 @@ def test_a_primitive_wall_placed_by_a_variable_is_read():
     with pytest.raises(ScriptError, match=r"in.x:7: primitive wall the host cannot read"):
         parse_wall(Command("fix w all wall/gran model hertz tangential history primitive type ${t} zplane 0.0",
                            "in.x", 7))
+
+
+@pytest.mark.parametrize("line, files", [
+    ("dump dmp all custom 5000 ../DEM/post/dump.liggghts_run id type x y z", []),     # LIGGGHTS makes its folder
+    ('fix extra all print 100 "${time} ${vx}" file ../DEM/post/velocity.txt title "#" screen no',
+     ["../DEM/post/velocity.txt"]),
+    ("fix av all ave/time 1 10 10 c_t append out/t.txt", ["out/t.txt"]),
+    ("write_restart post/restart/liggghts.restart", []),                               # this one too
+    ("write_data post/x.data", ["post/x.data"]),
+    ("restart 1000 post/a.restart post/b.restart", ["post/a.restart", "post/b.restart"]),
+    ("restart 0", []),
+    ("write_dump all custom post/last.dump id x", []),
+    ("fix Temp all property/atom Temp scalar yes yes no 0.0", []),
+])
+def test_a_scripts_output_files_are_found(line, files):
+    """The files a LIGGGHTS command opens without making their folder (settlingTestMPI's fix
+    print into DEM/post: the host makes it), read from each command's words in LIGGGHTS'
+    order; dumps and write_restart are left out, LIGGGHTS makes their folders itself."""
+    from pyhost.script import Command, output_files
+
+    assert output_files(Command(line, "in.test", 1)) == files
