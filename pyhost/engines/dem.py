@@ -38,6 +38,23 @@ t_coll up to this many steps is taken back whole (a longer one: its first 200 st
 as heat_gran_undo_cut)."""
 
 
+def refusal_hint(cmd: Command, message: str, ranks: int) -> str:
+    """What a user of a CFDEM tutorial does about two of LIGGGHTS' refusals of its scripts
+    as they are (docs/tutorials.md), appended to the refusal: a processor grid for another
+    number of ranks, and the restart that the tutorial's first stage writes."""
+    w = cmd.words
+    if w[0] == "processors" and "processors !=" in message and all(x.isdigit() for x in w[1:4]):
+        n = int(w[1]) * int(w[2]) * int(w[3])
+        return (f" (the script's grid is {' x '.join(w[1:4])} = {n} ranks, this run has {ranks}: run it under "
+                f"'mpirun -np {n} python -m pyhost run ...', or delete the line and LIGGGHTS divides the box itself)")
+    if w[0] == "read_restart" and "Cannot open restart file" in message:
+        first = sorted(p.name for p in Path(cmd.file).parent.glob("in.*init*"))
+        if first:
+            return (f" (a CFDEM tutorial writes it in its first stage, plain LIGGGHTS: run 'liggghts -in {first[0]}' "
+                    f"in {Path(cmd.file).parent.resolve()} first)")
+    return ""
+
+
 class Dem:
     """LIGGGHTS running a scene's script. ``walls``: the host's walls in order, each
     (fix id, material name or None for adiabatic LIGGGHTS walls the scene does not name)."""
@@ -93,7 +110,7 @@ class Dem:
         try:
             self._raw(cmd.text)
         except LiggghtsError as exc:
-            raise LiggghtsError(f"{cmd.where()}: {exc}") from None
+            raise LiggghtsError(f"{cmd.where()}: {exc}{refusal_hint(cmd, str(exc), 1 if self.link is None else self.link.size)}") from None
         self.info.learn(cmd)
         self.report_warnings(cmd)
 

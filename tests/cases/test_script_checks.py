@@ -358,3 +358,20 @@ def test_an_error_of_one_rank_names_the_script_line(tmp_path):
     last = len(script.splitlines())
     assert f"LIGGGHTS ended the process at {tmp_path}/in.run:{last} (run 5000): ERROR on proc" in r.stderr, r.stderr
     assert "Substitution for illegal variable" in r.stderr
+
+
+@pytest.mark.parametrize("first, words", [
+    ("processors 2 2 1\n", ["in.run:1", "Specified processors != physical processors",
+                            "the script's grid is 2 x 2 x 1 = 4 ranks, this run has 1", "mpirun -np 4"]),
+    ("read_restart post/restart/liggghts.restart\n", ["Cannot open restart file",
+                                                      "run 'liggghts -in in.liggghts_init'"]),
+])
+def test_a_cfdem_tutorials_first_stage_and_ranks_are_named(tmp_path, first, words):
+    """Two refusals a CFDEM tutorial run as it is meets (docs/tutorials.md): a processor grid
+    for 4 ranks on 1, and a read_restart of the file its first stage (in.liggghts_init, plain
+    LIGGGHTS) writes; exit 2, LIGGGHTS' message and what to do."""
+    (tmp_path / "in.liggghts_init").write_text("# the tutorial's first stage\n")
+    r, _ = run(tmp_path, first + header() + "run 10\n", toml())      # refused at its first line
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    for w in words:
+        assert w in r.stderr, (w, r.stderr[-2000:])
