@@ -149,7 +149,8 @@ class Post:
         self.particles = Particles()
         self.positions = {}             # step -> (ids, x, box, periodic) of a few particle frames
         self.summary = dict(frames=0, particles=0, collisions=dict(particle_particle=0, particle_wall=0),
-                            heat_J={m: 0.0 for m in self.models}, warnings=self.warnings, complete=False)
+                            contacts_open_at_start=0, heat_J={m: 0.0 for m in self.models}, warnings=self.warnings,
+                            complete=False)
         self.stop_step = None            # the last good step before a failure: nothing after it is used
         self.error, self.done = None, False
 
@@ -229,8 +230,21 @@ class Post:
         j[wall] = WALL_BASE + MESHES * np.array([k for k, _ in walls], np.int64)[c.j[wall] - WALL_BASE]
         keys = contact_keys(ids[c.i], j)
         new = first.new(keys)
-        window = (steps[-1] - steps[-2]) * self.dt if len(steps) > 1 else 0.0
+        if len(steps) == 1:
+            self.open_at_start(f, len(keys))
+            return
+        window = (steps[-1] - steps[-2]) * self.dt
         found.add(step=f.step, i=ids[c.i][new], j=j[new], delta=c.delta[new], approach=c.approach[new], window=window)
+
+    def open_at_start(self, f, n: int) -> None:
+        """The contacts of a stream's first frame began before the record does: their impact is
+        not in it (a resting bed's contacts, integrated back, would each get an impact speed
+        from their static overlap), so they are not collisions, as a run's contacts at a
+        restart are not. Counted in summary.json's ``contacts_open_at_start``."""
+        self.summary["contacts_open_at_start"] += n
+        if n:
+            self.warnings.append(f"{n} contacts are open in the first frame of {Path(f.file).name} (timestep "
+                                 f"{f.step}): they began before the dumps do, so they are not counted as collisions")
 
     def contact_streams(self) -> dict:
         """Contact dump files grouped by the compute their columns come from (one stream each)."""
@@ -253,7 +267,7 @@ class Post:
                 if missing:
                     raise DumpError(f.file, f.step, f.line, f"contact dump lacks {', '.join(missing)}: the compute "
                                                             "needs the keywords pos, vel and id, all dumped")
-                window = (f.step - previous) * self.dt if previous is not None else 0.0
+                window = (f.step - previous) * self.dt if previous is not None else None
                 if previous is not None:
                     intervals.append(f.step - previous)
                 previous = f.step
@@ -331,6 +345,9 @@ class Post:
         keys, first_row = np.unique(keys[order], return_index=True)
         rows = order[first_row]
         new = first.new(keys)
+        if window is None:                               # the stream's first frame
+            self.open_at_start(f, len(keys))
+            return
         rows = rows[new]
         found.add(step=f.step, i=ids_i[rows], j=j[rows], delta=delta[rows], approach=approach[rows], window=window)
 

@@ -150,6 +150,27 @@ def test_a_failure_keeps_what_came_before_and_says_incomplete(tmp_path):
     assert any("skipped" in w and "timestep 20" in w and "line 33" in w for w in summary["warnings"])
 
 
+def test_contacts_open_in_the_first_frame_are_not_collisions(tmp_path):
+    """Dumps that begin mid-run (a settled bed, a restart): a pair resting in contact in the
+    first frame began before the record and is not a collision (integrated back, its static
+    overlap alone gave it an impact at 5.3e-4 m/s and 4.6e-10 J from the hot sphere to the
+    cold one); a pair that meets between the frames is one, at its 0.2 m/s."""
+    head = HEAD.replace("NUMBER OF ATOMS\n2", "NUMBER OF ATOMS\n4")
+    rest = "1 1 0.002 0.005 0.005 0 0 0 0.0005 \n2 2 0.0029999 0.005 0.005 0 0 0 0.0005 \n"   # 0.1 um overlap
+    frames = [(0, 0.0060, 0.0080), (10, 0.00650005, 0.00749995)]
+    (tmp_path / "run.dump").write_text("".join(
+        head.format(step=s) + rest + f"3 1 {a} 0.005 0.005 0.1 0 0 0.0005 \n4 2 {b} 0.005 0.005 -0.1 0 0 0.0005 \n"
+        for s, a, b in frames))
+    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1, 2]\ntemperature = [400, 300]"))
+    run = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--out", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["contacts_open_at_start"] == 1 and summary["collisions"]["particle_particle"] == 1
+    assert any("1 contacts are open in the first frame of run.dump (timestep 0)" in w for w in summary["warnings"])
+    [row] = rows(tmp_path / "out")
+    assert (row["i"], row["j"]) == ("3", "4") and 0.2 < float(row["v0"]) < 0.2 * 1.01
+
+
 @pytest.mark.parametrize("change, problem", [
     (lambda s: s.replace("types = [1, 2]", "types = [1, 0]"), "types: atom types are integers >= 1"),
     (lambda s: s + STEEL_WALL.replace('fix = "walls"', 'fix = "walls"\nplane = "zlo"'), "give either fix"),
