@@ -128,6 +128,8 @@ class Script:
     box: np.ndarray | None = None   # (3, 2) lo hi [m] of its create_box, None if unknown
     heat_gran: tuple = ()           # ids of its fix heat/gran
     primitives: dict = field(default_factory=dict)  # primitive wall fix id -> (kind, numbers) (pyhost.walls)
+    globals: dict = field(default_factory=dict)     # property/global name -> (where, words after the name)
+    wall_types: dict = field(default_factory=dict)  # wall/gran fix id -> atom type of its primitive or first mesh
 
 
 SETUP_COMMANDS = ("units", "dimension", "boundary", "atom_style", "atom_modify", "newton", "communicate",
@@ -190,6 +192,7 @@ def read_script(path) -> Script:
         raise ValueError(f"{path}: cannot read the LIGGGHTS script: {exc.strerror}") from None
     timestep, computes, walls, warnings = None, {}, [], []
     setup, heat_gran, primitives, literal = [], [], {}, True
+    globals_, wall_types, mesh_types = {}, {}, {}
     text = re.sub(r"&[ \t]*\n", " ", text)
     for number, line in enumerate(text.splitlines(), start=1):
         words = line.split("#")[0].split()
@@ -205,7 +208,13 @@ def read_script(path) -> Script:
                 timestep, literal = None, False
         elif words[0] == "fix" and len(words) > 3 and words[3] == "heat/gran":
             heat_gran.append(words[1])
+        elif words[0] == "fix" and len(words) > 5 and words[3] == "property/global":
+            globals_[words[4]] = (where.rstrip(": "), words[5:])
+        elif words[0] == "fix" and len(words) > 3 and words[3].startswith("mesh/surface") and "type" in words[:-1]:
+            mesh_types[words[1]] = words[words.index("type") + 1]
         elif words[0] == "fix" and len(words) > 5 and words[3] == "wall/gran" and "primitive" in words:
+            if "type" in words[:-1]:
+                wall_types[words[1]] = words[words.index("type") + 1]
             kind = next((w for w in words if w in PRIMITIVES), None)
             numbers = words[words.index(kind) + 1:][:PRIMITIVES[kind]] if kind else []
             try:
@@ -218,6 +227,8 @@ def read_script(path) -> Script:
             computes[c.id] = c
         elif words[0] == "fix" and len(words) > 3 and words[3] == "wall/gran" and "mesh" in words:
             walls.append(words[1])
+            if "meshes" in words[:-1]:
+                wall_types[words[1]] = mesh_types.get(words[words.index("meshes") + 1])
         elif words[0] == "include":
             warnings.append(f"{where}include {' '.join(words[1:])} not followed")
     box = None
@@ -228,7 +239,9 @@ def read_script(path) -> Script:
                             "give --dt")
         elif not literal:
             timestep = dt
-    return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), primitives)
+    wall_types = {fix: int(t) for fix, t in wall_types.items() if t is not None and t.isdigit()}
+    return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), primitives, globals_,
+                  wall_types)
 
 
 @dataclass(frozen=True, eq=False)

@@ -24,6 +24,7 @@ import gzip
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -33,11 +34,13 @@ from plugins.heat import MODELS
 from plugins.heat.exchange import exchange_heat
 from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.contacts import find_contacts
+from pyhost.dem_input import script_dem_contacts
 from pyhost.dumps import DumpError, DumpReader, expand, local_compute
 from pyhost.outdir import write_atomic
 from pyhost.output import VtkSeries
 from pyhost.scene import read_toml
 from pyhost.schema import Material, SceneError, Wall, build, check_types
+from pyhost.script import ScriptError
 from pyhost.walls import FACES
 
 MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
@@ -77,6 +80,40 @@ def load_post_scene(path) -> PostScene:
                              f"({', '.join(FACES)})")
     return PostScene(path, materials, types, {t: materials[names[k]].temperature_of(t) for t, k in types.items()},
                      walls)
+
+
+class ScriptDem:
+    """The DEM values the script that wrote the dumps sets (``fix ... property/global``, plain
+    numbers; ``pyhost.dumps.Script.globals``), behind the part of the engine's interface that
+    ``pyhost.dem_input.script_dem_contacts`` reads: post's DEM contact of each material comes
+    from the script as a run's comes from the engine, and a [materials.NAME.dem] table must
+    agree with it. ``unread``: the values given as variables, which post cannot evaluate."""
+
+    def __init__(self, script):
+        numbers = {}
+        self.unread = {}
+        for prop, (where, words) in script.globals.items():
+            try:
+                numbers[prop] = (where, words[0], [float(x) for x in words[1:]])
+            except ValueError:
+                self.unread[prop] = where
+        self.values = numbers
+        self.info = SimpleNamespace(globals=numbers, wall_type=script.wall_types.get)
+
+    def _value(self, prop, k):
+        where, style, v = self.values[prop]
+        try:
+            return v[k]
+        except IndexError:
+            raise ScriptError(f"{where}: property/global {prop} {style}: too few values for the dumps' atom types") \
+                from None
+
+    def type_values(self, prop, types) -> np.ndarray:
+        return np.array([self._value(prop, int(t) - 1) for t in types])
+
+    def type_pair_value(self, prop, a, b) -> float:
+        n = int(self.values[prop][2][0]) if self.values[prop][2] else 0
+        return self._value(prop, 1 + (a - 1) * n + (b - 1))
 
 
 class Particles:
@@ -145,6 +182,7 @@ class Post:
         if self.dt is None:
             raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
         self.warnings = list(script.warnings) if script else []
+        self.materials = self.dem_contacts(scene, script)
         self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()
         self.positions = {}             # step -> (ids, x, box, periodic) of a few particle frames
@@ -153,6 +191,20 @@ class Post:
                             complete=False)
         self.stop_step = None            # the last good step before a failure: nothing after it is used
         self.error, self.done = None, False
+
+    @staticmethod
+    def dem_contacts(scene: PostScene, script) -> list:
+        """The scene's materials, each with the DEM contact the script sets for its atom types
+        (checked against a given dem table), or its table where there is no script."""
+        if script is None:
+            return list(scene.materials.values())
+        dem = ScriptDem(script)
+        try:
+            return script_dem_contacts(scene, dem)
+        except ScriptError as exc:
+            unread = "; ".join(f"{where}: {prop}" for prop, where in dem.unread.items())
+            raise ScriptError(f"{exc}" + (f" (post reads plain numbers; given as variables: {unread})" if unread
+                                           else "")) from None
 
     # -- reading ----------------------------------------------------------------------------
     def reader(self, paths, **kw):
@@ -369,7 +421,7 @@ class Post:
     def bodies(self, i, j):
         """Material index, radius [m] and mass [kg] of partners i (particles) and j (particle
         or wall), and whether j is a wall and which."""
-        mats = list(self.scene.materials.values())
+        mats = self.materials
         density = np.array([m.density for m in mats])
         wall = j >= WALL_BASE
         w = np.where(wall, (j - WALL_BASE) // MESHES, 0)
@@ -383,14 +435,15 @@ class Post:
         return mi, mj, R_i, R_j, m_i, m_j, wall, w
 
     def dem_laws(self, mi, mj):
-        mats = list(self.scene.materials.values())
+        mats = self.materials
         laws = {}
         for a, b in set(zip(mi.tolist(), mj.tolist())):
             for k in (a, b):
                 if mats[k].dem is None:
                     raise ValueError(f"{self.scene.path}: materials.{list(self.scene.materials)[k]}.dem: post "
-                                     f"recovers impact speeds with the DEM's contact law and reads no script "
-                                     f"values: give the table (youngs_modulus, restitution, poisson_ratio)")
+                                     f"recovers impact speeds with the DEM's contact law: give the table "
+                                     f"(youngs_modulus, restitution, poisson_ratio), or --script with the script's "
+                                     f"fix property/global")
             dem = dem_pair(mats[a], mats[b])
             laws[a, b] = (dem.Ystar, DemHertz(dem.Ystar, dem.restitution))
         return laws
@@ -454,7 +507,7 @@ class Post:
         replayed into the VTK series; collisions.csv.gz written batch by batch."""
         n = len(c["i"])
         mi, mj, R_i, R_j, m_i, m_j, wall, w = self.bodies(c["i"], c["j"])
-        mats = list(self.scene.materials.values())
+        mats = self.materials
         go = c["v0"] > 0                     # contacts that formed without approach move no collision heat
         if (~go).any():
             self.warnings.append(f"{int((~go).sum())} contacts formed with no approach speed: no collision heat")

@@ -97,6 +97,30 @@ def test_collision_counts_match_an_independent_count_of_the_contact_dumps(pour_d
 
 
 @pytest.mark.engines
+def test_the_dem_contact_comes_from_the_script(pour_dumps, tmp_path):
+    """With --script, post reads the DEM's moduli, Poisson ratios and restitutions from the
+    script's fix property/global (the particles' types and the mesh wall's type 1), as a run
+    reads them from the engine: a scene without dem tables gives the same collisions and heat,
+    to the last digit, as one whose tables state the script's values; a table that disagrees
+    is refused (exit 2) naming both."""
+    post_dir = pour_dumps / "post"
+    scenes = {"tables": GLASS + STEEL_WALL,
+              "none": "\n".join(ln for ln in (GLASS + STEEL_WALL).splitlines() if not ln.startswith("dem = ")),
+              "other": (GLASS + STEEL_WALL).replace("restitution = 0.8", "restitution = 0.5", 1)}
+    runs = {}
+    for name, text in scenes.items():
+        (tmp_path / f"{name}.toml").write_text(text)
+        runs[name] = post(post_dir / "dump.*", "--scene", tmp_path / f"{name}.toml", "--contacts", post_dir / "pair.*",
+                          post_dir / "wall.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / name)
+    assert runs["tables"].returncode == 0 and runs["none"].returncode == 0, runs["none"].stderr
+    table, none = rows(tmp_path / "tables"), rows(tmp_path / "none")
+    assert len(table) > 70 and table == none
+    assert runs["other"].returncode == 2
+    assert ("materials.glass.dem.restitution = 0.5 differs from the script's coefficientRestitution 0.8 of atom "
+            "type 1") in runs["other"].stderr
+
+
+@pytest.mark.engines
 def test_positions_alone_find_the_pairs_liggghts_listed_and_warn_about_a_long_interval(pour_dumps, tmp_path):
     """From positions dumped every 20 steps (the contact dumps' interval), the particle pairs are
     those of LIGGGHTS' own contact list; from dumps every 500 steps most are missed, and the

@@ -245,3 +245,30 @@ def test_script_primitive_walls_are_read_with_their_numbers(tmp_path):
                       "fix lid all wall/gran model hertz tangential history primitive type 1 zplane ${top}\n"
                       "fix cut all wall/gran model hertz tangential history primitive type 1 xcylinder 0.05\n")
     assert read_script(script).primitives == {"floor": ("zplane", (0.0,)), "drum": ("zcylinder", (0.05, 0.0, 0.0))}
+
+
+def test_the_scripts_dem_values_give_each_materials_dem_contact(tmp_path):
+    """post's DEM contact of each material from the script's fix property/global (per type, the
+    restitution per type pair read at (t, t)); the primitive wall's material from its type; a
+    value given as a variable cannot be read, and the refusal says so and where."""
+    from pyhost.post import Post, load_post_scene
+
+    material = ("density = 2500.0\nyoungs_modulus = 63e9\npoisson_ratio = 0.22\nyield_stress = 500e6\n"
+                "heat_capacity = 800.0\nconductivity = 1.0\n")
+    (tmp_path / "scene.toml").write_text(f"[materials.glass]\ntypes = [1]\n{material}[materials.steel]\ntypes = [2]\n"
+                                         f"{material}[materials.wood]\n{material}"
+                                         '[[walls]]\nfix = "floor"\nmaterial = "wood"\n')
+    script = tmp_path / "in.values"
+    text = ("timestep 1e-5\n"
+            "fix m1 all property/global youngsModulus peratomtype 5e6 2e7 3e7\n"
+            "fix m2 all property/global poissonsRatio peratomtype 0.3 0.25 0.2\n"
+            "fix m3 all property/global coefficientRestitution peratomtypepair 3 0.8 0.7 0.6 0.7 0.5 0.4 0.6 0.4 0.3\n"
+            "fix floor all wall/gran model hertz tangential history primitive type 3 zplane 0.0\n")
+    script.write_text(text)
+    glass, steel, wood = Post.dem_contacts(load_post_scene(tmp_path / "scene.toml"), read_script(script))
+    assert (glass.dem.youngs_modulus, glass.dem.poisson_ratio, glass.dem.restitution) == (5e6, 0.3, 0.8)
+    assert (steel.dem.youngs_modulus, steel.dem.poisson_ratio, steel.dem.restitution) == (2e7, 0.25, 0.5)
+    assert (wood.dem.youngs_modulus, wood.dem.poisson_ratio, wood.dem.restitution) == (3e7, 0.2, 0.3)
+    script.write_text(text.replace("peratomtype 5e6 2e7 3e7", "peratomtype ${E} ${E} ${E}"))
+    with pytest.raises(ValueError, match=r"sets no youngsModulus .*given as variables: .*in.values: line 2: youngsModulus"):
+        Post.dem_contacts(load_post_scene(tmp_path / "scene.toml"), read_script(script))
