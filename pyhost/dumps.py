@@ -130,6 +130,7 @@ class Script:
     primitives: dict = field(default_factory=dict)  # primitive wall fix id -> (kind, numbers) (pyhost.walls)
     globals: dict = field(default_factory=dict)     # property/global name -> (where, words after the name)
     wall_types: dict = field(default_factory=dict)  # wall/gran fix id -> atom type of its primitive or first mesh
+    temperature_sets: tuple = ()    # (step or None if unknown, where, command) of each 'set ... property/atom Temp'
 
 
 SETUP_COMMANDS = ("units", "dimension", "boundary", "atom_style", "atom_modify", "newton", "communicate",
@@ -182,9 +183,26 @@ def local_compute(path) -> str:
     return head[8].split()[2].split("[")[0][2:]
 
 
+def _joined(text: str):
+    """(number of its first line, text) of each command of a script, '&' continuations joined."""
+    pending, first = "", 1
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not pending:
+            first = number
+        if re.search(r"&[ \t]*$", line):
+            pending += re.sub(r"&[ \t]*$", " ", line)
+            continue
+        yield first, pending + line
+        pending = ""
+    if pending:
+        yield first, pending
+
+
 def read_script(path) -> Script:
-    """Reads ``timestep``, the local computes and the mesh wall fixes of a LIGGGHTS input
-    (``&`` continuations and ``#`` comments handled; ``include`` is not followed)."""
+    """Reads ``timestep``, the local computes and the mesh wall fixes of a LIGGGHTS input, its
+    property/globals, wall types, and the steps at which it sets particles' Temp (counted
+    through its plain-number ``run N [upto]`` and ``reset_timestep``) (``&`` continuations and
+    ``#`` comments handled; ``include`` is not followed)."""
     path = Path(path)
     try:
         text = path.read_text()
@@ -193,8 +211,8 @@ def read_script(path) -> Script:
     timestep, computes, walls, warnings = None, {}, [], []
     setup, heat_gran, primitives, literal = [], [], {}, True
     globals_, wall_types, mesh_types = {}, {}, {}
-    text = re.sub(r"&[ \t]*\n", " ", text)
-    for number, line in enumerate(text.splitlines(), start=1):
+    step, temperature_sets, ran = 0, [], False    # the step reached (None: unknown, a $variable); any run yet
+    for number, line in _joined(text):
         words = line.split("#")[0].split()
         if not words:
             continue
@@ -231,6 +249,14 @@ def read_script(path) -> Script:
                 wall_types[words[1]] = mesh_types.get(words[words.index("meshes") + 1])
         elif words[0] == "include":
             warnings.append(f"{where}include {' '.join(words[1:])} not followed")
+        elif words[0] in ("run", "reset_timestep", "read_restart"):
+            n = int(words[1]) if len(words) > 1 and words[1].isdigit() and words[0] != "read_restart" else None
+            step = (None if n is None else n if words[0] == "reset_timestep" or "upto" in words[2:]
+                    else None if step is None else step + n)
+            ran = ran or words[0] == "run"
+        elif (words[0] == "set" and ran and "property/atom" in words[:-2]
+              and words[words.index("property/atom") + 1] == "Temp"):     # (before any run: the first frame's)
+            temperature_sets.append((step, where.rstrip(": "), " ".join(words)))
     box = None
     if not literal or any(t.split()[0] == "create_box" for _, t in setup):
         dt, box, why = resolve_setup(setup, path)
@@ -241,7 +267,7 @@ def read_script(path) -> Script:
             timestep = dt
     wall_types = {fix: int(t) for fix, t in wall_types.items() if t is not None and t.isdigit()}
     return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), primitives, globals_,
-                  wall_types)
+                  wall_types, tuple(temperature_sets))
 
 
 @dataclass(frozen=True, eq=False)

@@ -11,7 +11,8 @@
 3. Each model gives every collision's heat per kelvin, e and t_coll (``plugins.heat.batch.evaluate``);
    the heat is moved collision by collision, in time order, with the temperatures of that
    moment (``plugins.heat.exchange.exchange_heat``), while the particle dumps are replayed into a VTK
-   series of temperatures and heat received.
+   series of temperatures and heat received. A script's ``set ... property/atom Temp`` between
+   frames changes every model's temperatures by what the dumped temperature changed across it.
 
 Output (``out``): collisions.csv.gz, summary.json, vtk/particles.pvd, post.png. A failure
 keeps what was written before it, and summary.json then says ``"complete": false``, as it
@@ -247,8 +248,7 @@ class Post:
             if unknown:
                 raise ValueError(f"{f.file}: timestep {f.step}: atom type {unknown[0]} is in no material of "
                                  f"{self.scene.path} (materials.NAME.types)")
-            column = next((c for c in ("f_Temp", *(f"f_{h}" for h in (self.script.heat_gran if self.script else ())))
-                           if c in f), None)
+            column = self.temperature_column(f)
             self.particles.add(ids, types, f["radius"], f[column] if column else None)
             if self.contacts and len(self.positions) < 8:       # a few frames to check contact dumps against
                 self.positions[f.step] = (ids, f.positions(), self.frame_box(f), f.periodic)
@@ -261,6 +261,11 @@ class Post:
         self.dump_steps = np.diff(steps).min() if len(steps) > 1 else None
         self.interval = self.dump_steps
         return found
+
+    def temperature_column(self, f) -> str | None:
+        """The frame's column of LIGGGHTS' particle temperature (f_Temp, or a heat/gran's own)."""
+        return next((c for c in ("f_Temp", *(f"f_{h}" for h in (self.script.heat_gran if self.script else ())))
+                     if c in f), None)
 
     def frame_box(self, f):
         """The frame's box (3, 2) [m]; a VTK dump has none: the script's (``--script``)."""
@@ -580,8 +585,18 @@ class Post:
                 gz.flush()
                 done = end
 
+            sets = sorted(s for s in (self.script.temperature_sets if self.script else ()) if s[0] is not None)
+            unplaced, before = [s for s in (self.script.temperature_sets if self.script else ()) if s[0] is None], None
             for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
+                while sets and sets[0][0] < f.step:
+                    if before is None:          # before the first frame: in the first appearances' temperatures
+                        sets.pop(0)
+                        continue
+                    upto(sets[0][0])            # what collided before the script's set, then the set
+                    self.follow_set(sets.pop(0), before, f, T)
                 upto(f.step)
+                column = self.temperature_column(f)
+                before = (f.step, f["id"].astype(np.int64), f[column] if column else None)
                 ids = f["id"].astype(np.int64)
                 fields = dict(id=ids, type=f["type"].astype(int), radius=f["radius"], velocity=f.vector("v"))
                 for m in self.models:
@@ -592,11 +607,38 @@ class Post:
                 pair_heat.append(pair_sum.copy())
                 last = (f.time, f.positions(), fields[f"dT_{self.models[0]}"], self.models[0])
             upto(np.inf if self.stop_step is None else self.stop_step)
+        for step, where, command in unplaced + sets:
+            self.warnings.append(f"{where}: '{command}' {'at an unknown step' if step is None else f'at step {step}'}"
+                                 f": no dump frames on both sides of it, so post's temperatures do not follow it")
         self.done = True
         if last is not None:
             from pyhost.pictures import plot_post
             self.summary["picture"] = str(plot_post(self.out, last, [f"{a}-{b or 'wall'}" for a, b in pairs],
                                                     times, pair_heat))
+
+    def follow_set(self, temperature_set, before, f, T) -> None:
+        """A script's ``set ... property/atom Temp`` at a step between two frames: each
+        particle's temperature in every model changes by what the dumps' temperature changed
+        between the frames (which holds the set and the script's own conduction over those
+        steps: heat/gran's, if any). Listed in summary.json's ``temperature_sets``."""
+        step, where, command = temperature_set
+        column = self.temperature_column(f)
+        if before[2] is None or column is None:
+            self.warnings.append(f"{where}: '{command}' at step {step}: the dumps have no particle temperature "
+                                 "(f_Temp), so post's temperatures do not follow it")
+            return
+        ids0, T0 = before[1], before[2]
+        ids = f["id"].astype(np.int64)
+        at = np.full(int(max(ids.max(initial=0), ids0.max(initial=0))) + 1, -1)
+        at[ids0] = np.arange(len(ids0))
+        both = at[ids] >= 0
+        change = f[column][both] - T0[at[ids][both]]
+        for m in self.models:
+            T[m][ids[both]] += change
+        moved = np.abs(change) > 0
+        self.summary.setdefault("temperature_sets", []).append(dict(
+            step=step, where=where, command=command, frames=[before[0], f.step], particles_changed=int(moved.sum()),
+            mean_change_K=float(change[moved].mean()) if moved.any() else 0.0))
 
     def initial_temperatures(self, known, mat) -> np.ndarray:
         T0 = np.full(len(self.particles.type), np.nan)

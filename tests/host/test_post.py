@@ -195,6 +195,36 @@ def test_contacts_open_in_the_first_frame_are_not_collisions(tmp_path):
     assert (row["i"], row["j"]) == ("3", "4") and 0.2 < float(row["v0"]) < 0.2 * 1.01
 
 
+def test_a_scripts_set_of_temperatures_is_followed(tmp_path):
+    """A script that sets particles' Temp between runs (Debian's heatTransfer tutorials heat half
+    their bed after it settles): post's temperatures change by what the dumps' temperature
+    changed across the set, so a pair meeting after it moves heat from 400 K to 250 K: three times
+    what the same dumps give without the set (particle 1 kept its first appearance's 300 K); a
+    set before the first run is in the first frame already."""
+    script = tmp_path / "in.heat"
+    script.write_text("timestep 1e-6\nset atom 2 property/atom Temp 250\nrun 10 upto\n"
+                      "set atom 1 property/atom Temp 400 # the hot one\nrun 20 upto\n")
+    head = HEAD.replace("radius \n", "radius f_Temp\n")
+    frames = [(0, 0.0040, 0.0060, 300), (10, 0.0042, 0.0058, 300), (20, 0.00450005, 0.00549995, 400)]
+    (tmp_path / "run.dump").write_text("".join(
+        head.format(step=s) + f"1 1 {a} 0.005 0.005 0.1 0 0 0.0005 {T}\n2 1 {b} 0.005 0.005 -0.1 0 0 0.0005 250\n"
+        for s, a, b, T in frames))
+    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1]"))
+    run = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--script", script, "--out", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    [done] = summary["temperature_sets"]
+    assert (done["step"], done["frames"], done["particles_changed"], done["mean_change_K"]) == (10, [10, 20], 1, 100.0)
+    assert done["where"].endswith("in.heat: line 4")
+    [row] = rows(tmp_path / "out")
+    assert (row["i"], row["j"], float(row["time"])) == ("1", "2", pytest.approx(2e-5)) and float(row["Q_A"]) > 0
+    assert summary["heat_J"]["A"] == pytest.approx(float(row["Q_A"]))
+    script.write_text(script.read_text().replace("set atom 1", "# set atom 1"))
+    unset = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--script", script, "--out", tmp_path / "b")
+    assert unset.returncode == 0, unset.stderr
+    assert float(row["Q_A"]) == pytest.approx(3.0 * float(rows(tmp_path / "b")[0]["Q_A"]), rel=1e-9)
+
+
 @pytest.mark.parametrize("change, problem", [
     (lambda s: s.replace("types = [1, 2]", "types = [1, 0]"), "types: atom types are integers >= 1"),
     (lambda s: s + STEEL_WALL.replace('fix = "walls"', 'fix = "walls"\nplane = "zlo"'), "give either fix"),

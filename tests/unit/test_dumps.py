@@ -272,3 +272,18 @@ def test_the_scripts_dem_values_give_each_materials_dem_contact(tmp_path):
     script.write_text(text.replace("peratomtype 5e6 2e7 3e7", "peratomtype ${E} ${E} ${E}"))
     with pytest.raises(ValueError, match=r"sets no youngsModulus .*given as variables: .*in.values: line 2: youngsModulus"):
         Post.dem_contacts(load_post_scene(tmp_path / "scene.toml"), read_script(script))
+
+
+def test_the_steps_of_a_scripts_temperature_sets(tmp_path):
+    """Where a script sets Temp, counted through its runs (plain numbers; 'upto'; reset_timestep;
+    a $variable makes the step unknown until a reset), with the line it is on after '&'
+    continuations; a set before any run is the first frame's and not listed."""
+    script = tmp_path / "in.sets"
+    script.write_text("timestep 1e-5\nset group all property/atom Temp 300\nrun 100\n"
+                      "set region hot property/atom Temp 800. # half\n"
+                      "run 500 upto &\n   post no\nset type 2 property/atom Temp 250\nrun ${n}\n"
+                      "set type 1 property/atom Temp 350\nreset_timestep 0\nrun 7\nset atom 3 property/atom Temp 9\n")
+    sets = read_script(script).temperature_sets
+    assert [(step, where.rsplit(": ", 1)[1]) for step, where, _ in sets] == \
+        [(100, "line 4"), (500, "line 7"), (None, "line 9"), (7, "line 12")]
+    assert sets[0][2] == "set region hot property/atom Temp 800."
