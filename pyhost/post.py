@@ -183,6 +183,10 @@ class Post:
         if self.dt is None:
             raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
         self.warnings = list(script.warnings) if script else []
+        if script and script.heat_gran:
+            self.warnings.append(f"the script conducts heat with fix heat/gran ({', '.join(script.heat_gran)}): post's "
+                                 "temperatures change by its models' collision heat and the script's Temp sets only, "
+                                 "not by heat/gran's conduction through lasting contacts or its heat sources")
         self.materials = self.dem_contacts(scene, script)
         self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()

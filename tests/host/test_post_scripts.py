@@ -115,7 +115,8 @@ def test_vtk_dumps_take_the_box_from_the_script(drop):
 def test_temperature_column_of_a_heat_gran_fix_id(tmp_path):
     """A script that dumps its fix heat/gran by id (``f_heattransfer``: LIGGGHTS writes the
     temperature there) gives post the particles' temperatures: the scene needs none, and the
-    impact on the 350 K floor moves heat into the 300 K sphere."""
+    impact on the 350 K floor moves heat into the 300 K sphere; and post says that heat/gran's
+    own conduction is not in its temperatures."""
     (tmp_path / "post").mkdir()
     script = SCRIPT.replace("radius f_Temp[0]\ndump vtk", "radius f_heattransfer\ndump vtk")
     (tmp_path / "in.drop").write_text(script.replace("dump vtk all custom/vtk 20 post/drop*.vtk id type x y z vx vy vz "
@@ -128,3 +129,4 @@ def test_temperature_column_of_a_heat_gran_fix_id(tmp_path):
     summary = post(tmp_path, "dump.*", "out")
     print(summary["heat_J"])
     assert summary["heat_J"]["A"] > 0
+    assert any("fix heat/gran (heattransfer)" in w and "not by heat/gran's conduction" in w for w in summary["warnings"])
