@@ -44,6 +44,11 @@ from pyhost.schema import Material, SceneError, Wall, build, check_types
 from pyhost.script import ScriptError
 from pyhost.walls import FACES
 
+TEMPERATURES = ("own", "dumps")
+"""How post's particle temperatures evolve: ``own``, from each particle's first temperature by
+the models' collision heat (and the script's Temp sets); ``dumps``, taken from the dumps at every
+frame (the run's own conduction and sources), the collisions until the next frame moving heat
+from there: what the models' collisions would move in the run's own temperature field."""
 MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
 
 
@@ -174,7 +179,10 @@ class Post:
     """One post-processing job; ``run()`` writes the output folder and returns the summary."""
 
     def __init__(self, dumps, scene: PostScene, out, contacts=(), script=None, computes=None, models=tuple(MODELS),
-                 dt=None, skip_bad_frames=False):
+                 dt=None, skip_bad_frames=False, temperatures="own"):
+        if temperatures not in TEMPERATURES:
+            raise ValueError(f"temperatures: {temperatures!r} is not one of {', '.join(TEMPERATURES)}")
+        self.temperatures = temperatures
         self.dumps, self.scene, self.out = list(dumps), scene, Path(out)
         self.contacts, self.script = list(contacts), script
         self.computes = dict(script.computes if script else {}) | dict(computes or {})
@@ -183,17 +191,18 @@ class Post:
         if self.dt is None:
             raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
         self.warnings = list(script.warnings) if script else []
-        if script and script.heat_gran:
+        if script and script.heat_gran and temperatures == "own":
             self.warnings.append(f"the script conducts heat with fix heat/gran ({', '.join(script.heat_gran)}): post's "
                                  "temperatures change by its models' collision heat and the script's Temp sets only, "
-                                 "not by heat/gran's conduction through lasting contacts or its heat sources")
+                                 "not by heat/gran's conduction through lasting contacts or its heat sources "
+                                 "(--temperatures dumps takes the dumped temperatures at every frame)")
         self.materials = self.dem_contacts(scene, script)
         self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()
         self.positions = {}             # step -> (ids, x, box, periodic) of a few particle frames
         self.summary = dict(frames=0, particles=0, collisions=dict(particle_particle=0, particle_wall=0),
                             contacts_open_at_start=0, heat_J={m: 0.0 for m in self.models}, warnings=self.warnings,
-                            complete=False)
+                            complete=False, temperatures=temperatures)
         self.stop_step = None            # the last good step before a failure: nothing after it is used
         self.error, self.done = None, False
 
@@ -589,8 +598,9 @@ class Post:
                 gz.flush()
                 done = end
 
-            sets = sorted(s for s in (self.script.temperature_sets if self.script else ()) if s[0] is not None)
-            unplaced, before = [s for s in (self.script.temperature_sets if self.script else ()) if s[0] is None], None
+            told = self.script.temperature_sets if self.script and self.temperatures == "own" else ()
+            sets = sorted(s for s in told if s[0] is not None)
+            unplaced, before = [s for s in told if s[0] is None], None
             for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
                 while sets and sets[0][0] < f.step:
                     if before is None:          # before the first frame: in the first appearances' temperatures
@@ -602,6 +612,12 @@ class Post:
                 column = self.temperature_column(f)
                 before = (f.step, f["id"].astype(np.int64), f[column] if column else None)
                 ids = f["id"].astype(np.int64)
+                if self.temperatures == "dumps":      # the run's own temperatures from here to the next frame
+                    if column is None:
+                        raise DumpError(f.file, f.step, f.line, "--temperatures dumps: the frame has no particle "
+                                                                "temperature (f_Temp)")
+                    for m in self.models:
+                        T[m][ids] = f[column]
                 fields = dict(id=ids, type=f["type"].astype(int), radius=f["radius"], velocity=f.vector("v"))
                 for m in self.models:
                     fields[f"T_{m}"], fields[f"dT_{m}"] = T[m][ids], T[m][ids] - T0[ids]

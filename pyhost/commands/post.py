@@ -26,6 +26,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", type=Path, default=Path("collheat-post"), help="output folder")
     p.add_argument("--dt", type=float, help="DEM time step [s] (default: the script's timestep)")
     p.add_argument("--skip-bad-frames", action="store_true", help="warn about a bad frame, skip it and go on")
+    p.add_argument("--temperatures", choices=("own", "dumps"), default="own",
+                   help="own: each particle from its first temperature, changed by the models' collision heat (and "
+                        "the script's Temp sets); dumps: the dumped temperature (f_Temp) at every frame, as the run's "
+                        "own conduction and sources left it, the collisions until the next frame moving heat from there")
 
 
 def run(args) -> int:
@@ -39,7 +43,7 @@ def run(args) -> int:
         raise ValueError(f"--dt: must be > 0, got {args.dt}")
     post = Post(args.dumps, scene, args.out, contacts=args.contacts, script=script, computes=computes,
                 models=tuple(MODELS) if args.model == "all" else (args.model,), dt=args.dt,
-                skip_bad_frames=args.skip_bad_frames)
+                skip_bad_frames=args.skip_bad_frames, temperatures=args.temperatures)
     summary = post.run()
     for w in summary["warnings"]:
         print("warning:", w)

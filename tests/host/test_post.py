@@ -195,6 +195,18 @@ def test_contacts_open_in_the_first_frame_are_not_collisions(tmp_path):
     assert (row["i"], row["j"]) == ("3", "4") and 0.2 < float(row["v0"]) < 0.2 * 1.01
 
 
+def hot_and_cold(tmp_path, hot_from: int) -> None:
+    """run.dump: two glass spheres approaching at 0.1 m/s each, meeting between steps 10 and 20;
+    sphere 2 dumped at 250 K, sphere 1 at 300 K until step ``hot_from``, then at 400 K; and
+    scene.toml, its material taking the dumped temperatures."""
+    head = HEAD.replace("radius \n", "radius f_Temp\n")
+    frames = [(0, 0.0040, 0.0060), (10, 0.0042, 0.0058), (20, 0.00450005, 0.00549995)]
+    (tmp_path / "run.dump").write_text("".join(
+        head.format(step=s) + f"1 1 {a} 0.005 0.005 0.1 0 0 0.0005 {400 if s >= hot_from else 300}\n"
+        f"2 1 {b} 0.005 0.005 -0.1 0 0 0.0005 250\n" for s, a, b in frames))
+    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1]"))
+
+
 def test_a_scripts_set_of_temperatures_is_followed(tmp_path):
     """A script that sets particles' Temp between runs (Debian's heatTransfer tutorials heat half
     their bed after it settles): post's temperatures change by what the dumps' temperature
@@ -204,12 +216,7 @@ def test_a_scripts_set_of_temperatures_is_followed(tmp_path):
     script = tmp_path / "in.heat"
     script.write_text("timestep 1e-6\nset atom 2 property/atom Temp 250\nrun 10 upto\n"
                       "set atom 1 property/atom Temp 400 # the hot one\nrun 20 upto\n")
-    head = HEAD.replace("radius \n", "radius f_Temp\n")
-    frames = [(0, 0.0040, 0.0060, 300), (10, 0.0042, 0.0058, 300), (20, 0.00450005, 0.00549995, 400)]
-    (tmp_path / "run.dump").write_text("".join(
-        head.format(step=s) + f"1 1 {a} 0.005 0.005 0.1 0 0 0.0005 {T}\n2 1 {b} 0.005 0.005 -0.1 0 0 0.0005 250\n"
-        for s, a, b, T in frames))
-    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1]"))
+    hot_and_cold(tmp_path, hot_from=20)
     run = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--script", script, "--out", tmp_path / "out")
     assert run.returncode == 0, run.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
@@ -223,6 +230,29 @@ def test_a_scripts_set_of_temperatures_is_followed(tmp_path):
     unset = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--script", script, "--out", tmp_path / "b")
     assert unset.returncode == 0, unset.stderr
     assert float(row["Q_A"]) == pytest.approx(3.0 * float(rows(tmp_path / "b")[0]["Q_A"]), rel=1e-9)
+
+
+def test_temperatures_from_the_dumps(tmp_path):
+    """--temperatures dumps: at every frame each particle takes its dumped temperature (a run's
+    own conduction or heat sources raised particle 1 from 300 K to 400 K, which post's own
+    temperatures never see), so the pair meeting after that frame moves heat from 400 K to
+    250 K: three times what the default gives; dumps without a temperature are refused."""
+    hot_and_cold(tmp_path, hot_from=10)
+    Q = {}
+    for mode in ("own", "dumps"):
+        r = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--temperatures", mode,
+                 "--out", tmp_path / mode)
+        assert r.returncode == 0, r.stderr
+        [row] = rows(tmp_path / mode)
+        Q[mode] = float(row["Q_A"])
+        assert json.loads((tmp_path / mode / "summary.json").read_text())["temperatures"] == mode
+    assert Q["own"] > 0 and Q["dumps"] == pytest.approx(3.0 * Q["own"], rel=1e-9)
+    (tmp_path / "cold.dump").write_text((tmp_path / "run.dump").read_text().replace(" f_Temp\n", "\n")
+                                        .replace(" 300\n", "\n").replace(" 400\n", "\n").replace(" 250\n", "\n"))
+    (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1]\ntemperature = 300"))
+    r = post(tmp_path / "cold.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--temperatures", "dumps",
+             "--out", tmp_path / "cold")
+    assert r.returncode == 2 and "--temperatures dumps: the frame has no particle temperature (f_Temp)" in r.stderr
 
 
 @pytest.mark.parametrize("change, problem", [
