@@ -104,20 +104,20 @@ class Dem:
                 self.log(f"made the folder {folder.resolve()} for {name} ({cmd.where()}): LIGGGHTS does not make it")
 
     def command(self, cmd: Command) -> None:
-        """Run one script command (its output folders made first); a refusal names the
-        script's file and line."""
-        self.make_folders(cmd)
+        """Run one script command; a refusal names the script's file and line."""
         try:
             self._raw(cmd.text)
         except LiggghtsError as exc:
-            raise LiggghtsError(f"{cmd.where()}: {exc}{refusal_hint(cmd, str(exc), 1 if self.link is None else self.link.size)}") from None
+            ranks = 1 if self.link is None else self.link.size
+            raise LiggghtsError(f"{cmd.where()}: {exc}{refusal_hint(cmd, str(exc), ranks)}") from None
         self.info.learn(cmd)
         self.report_warnings(cmd)
 
     def commands(self, cmds: list[Command]) -> None:
         """The script's commands up to its next ``run`` (none of them a run), in order. A serial
         run tries them together first in one forked copy (each is otherwise tried alone: see
-        ``Liggghts.try_ahead``); a refusal names the script's file and line."""
+        ``Liggghts.try_ahead``), the folders of the files they open made first; a refusal names
+        the script's file and line."""
         for cmd in cmds:
             self.make_folders(cmd)
         if self.link is None:
