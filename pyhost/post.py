@@ -197,6 +197,12 @@ class Post:
                                  "not by heat/gran's conduction through lasting contacts or its heat sources "
                                  "(--temperatures dumps takes the dumped temperatures at every frame)")
         self.materials = self.dem_contacts(scene, script)
+        if script:
+            unnamed = (set(script.wall_types) | set(script.primitives) | set(script.mesh_wall_fixes)) \
+                - {w.fix for w in scene.walls if w.fix}
+            if unnamed:
+                self.warnings.append(f"the script's walls {', '.join(sorted(unnamed))} have no [[walls]] entry in "
+                                     f"{scene.path}: their collisions are not counted")
         self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()
         self.positions = {}             # step -> (ids, x, box, periodic) of a few particle frames

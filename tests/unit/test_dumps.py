@@ -266,6 +266,10 @@ def test_the_scripts_dem_values_give_each_materials_dem_contact(tmp_path):
             "fix floor all wall/gran model hertz tangential history primitive type 3 zplane 0.0\n")
     script.write_text(text)
     glass, steel, wood = Post.dem_contacts(load_post_scene(tmp_path / "scene.toml"), read_script(script))
+    script.write_text(text + "fix lid all wall/gran model hertz tangential history primitive type 3 zplane 0.1\n")
+    post = Post([], load_post_scene(tmp_path / "scene.toml"), tmp_path / "out", script=read_script(script))
+    assert any("the script's walls lid have no [[walls]] entry" in w for w in post.warnings)     # floor has one
+    script.write_text(text)
     assert (glass.dem.youngs_modulus, glass.dem.poisson_ratio, glass.dem.restitution) == (5e6, 0.3, 0.8)
     assert (steel.dem.youngs_modulus, steel.dem.poisson_ratio, steel.dem.restitution) == (2e7, 0.25, 0.5)
     assert (wood.dem.youngs_modulus, wood.dem.poisson_ratio, wood.dem.restitution) == (3e7, 0.2, 0.3)
