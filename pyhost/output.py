@@ -444,9 +444,13 @@ class VtkSeries:
 class Progress:
     """Prints simulated time, rate and time left at most every ``every`` seconds of wall time."""
 
-    def __init__(self, end: float, every: float = 5.0, stream=sys.stdout):
-        self.end, self.every, self.stream = end, every, stream
+    def __init__(self, end: float, every: float = 5.0, stream=None):
+        self.end, self.every, self._stream = end, every, stream        # None: sys.stdout when printing
         self.start = self.last = time.perf_counter()
+
+    @property
+    def stream(self):
+        return self._stream or sys.stdout
 
     def update(self, t: float, extra: str = "", force: bool = False) -> None:
         now = time.perf_counter()

@@ -38,7 +38,7 @@ from pyhost.contacts import find_contacts
 from pyhost.dem_input import script_dem_contacts
 from pyhost.dumps import DumpError, DumpReader, expand, local_compute
 from pyhost.outdir import write_atomic
-from pyhost.output import VtkSeries
+from pyhost.output import Progress, VtkSeries
 from pyhost.scene import read_toml
 from pyhost.schema import Material, SceneError, Wall, build, check_types
 from pyhost.script import ScriptError
@@ -152,6 +152,9 @@ class Found:
         for c in self.columns:
             self.parts[c].append(np.broadcast_to(arrays[c], np.shape(arrays["i"])).astype(float))
 
+    def count(self) -> int:
+        return sum(len(a) for a in self.parts["i"])
+
     def array(self) -> dict:
         out = {c: np.concatenate(v) if v else np.zeros(0) for c, v in self.parts.items()}
         order = np.argsort(out["step"], kind="stable")
@@ -179,10 +182,11 @@ class Post:
     """One post-processing job; ``run()`` writes the output folder and returns the summary."""
 
     def __init__(self, dumps, scene: PostScene, out, contacts=(), script=None, computes=None, models=tuple(MODELS),
-                 dt=None, skip_bad_frames=False, temperatures="own"):
+                 dt=None, skip_bad_frames=False, temperatures="own", progress_every=5.0):
         if temperatures not in TEMPERATURES:
             raise ValueError(f"temperatures: {temperatures!r} is not one of {', '.join(TEMPERATURES)}")
         self.temperatures = temperatures
+        self.progress_every = progress_every    # wall seconds between progress lines [s]
         self.dumps, self.scene, self.out = list(dumps), scene, Path(out)
         self.contacts, self.script = list(contacts), script
         self.computes = dict(script.computes if script else {}) | dict(computes or {})
@@ -261,7 +265,10 @@ class Post:
                     self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps (wall/gran/local), "
                                          "or --script when it is a primitive wall; without them it is ignored")
         steps, last = [], None
+        progress = Progress(float("inf"), self.progress_every)
         for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
+            progress.update(f.time, f"; reading the dumps: frame {len(steps) + 1}, {found.count()} collisions "
+                                    "found")
             ids, types = f["id"].astype(np.int64), f["type"].astype(int)
             unknown = sorted(set(types.tolist()) - set(self.scene.types))
             if unknown:
@@ -334,7 +341,9 @@ class Post:
         intervals = []
         for cid, paths in self.contact_streams().items():
             first, previous = FirstAppearances(), None
+            progress = Progress(float("inf"), self.progress_every)
             for f in self.frames(self.reader(paths, computes=self.computes)):
+                progress.update(f.time, f"; reading the contact dumps of {cid}: {found.count()} collisions found")
                 if f.kind not in ("pair", "wall"):
                     raise DumpError(f.file, f.step, f.line, "not a dump of compute pair/gran/local or wall/gran/local")
                 missing = [g for g in ("x_i", "v_i", "id_i") + (("x_j", "v_j", "id_j") if f.kind == "pair"
@@ -607,7 +616,9 @@ class Post:
             told = self.script.temperature_sets if self.script and self.temperatures == "own" else ()
             sets = sorted(s for s in told if s[0] is not None)
             unplaced, before = [s for s in told if s[0] is None], None
+            progress = Progress(float("inf"), self.progress_every)
             for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
+                progress.update(f.time, f"; replaying the dumps: heat of {done} of {n} collisions moved")
                 while sets and sets[0][0] < f.step:
                     if before is None:          # before the first frame: in the first appearances' temperatures
                         sets.pop(0)

@@ -364,3 +364,19 @@ def test_contact_dumps_of_another_run_are_refused(pour_dumps, tmp_path):
     same = post(pour_dumps / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
                 pour_dumps / "post" / "pair.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / "same")
     assert same.returncode == 0, same.stderr
+
+
+def test_progress_lines_on_a_long_job(tmp_path, capsys):
+    """post says where it is while it reads and replays the dumps (every 5 s of wall time by
+    default; here at every frame): the dump time reached and the collisions found, then moved."""
+    from pyhost.post import Post
+
+    hot_and_cold(tmp_path, hot_from=10)
+    Post([tmp_path / "run.dump"], load_post_scene(tmp_path / "scene.toml"), tmp_path / "out", dt=1e-6,
+         progress_every=0.0).run()
+    lines = capsys.readouterr().out.splitlines()
+    assert [ln.split(";")[1].strip() for ln in lines] == \
+        ["reading the dumps: frame 1, 0 collisions found", "reading the dumps: frame 2, 0 collisions found",
+         "reading the dumps: frame 3, 0 collisions found", "replaying the dumps: heat of 0 of 1 collisions moved",
+         "replaying the dumps: heat of 0 of 1 collisions moved", "replaying the dumps: heat of 0 of 1 collisions moved"]
+    assert lines[2].startswith("t = 2e-05 s")
