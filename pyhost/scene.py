@@ -131,12 +131,39 @@ def check_raw(data: dict, file: str) -> None:
         _finite(value, key, file)
 
 
+def what_is_here(folder: Path) -> str:
+    """What a folder without a scene file holds and how to make it a case of the host (a
+    CFDEM tutorial, its OpenFOAM folder, a DPMFoam case, a LIGGGHTS script), as a hint
+    appended to the missing file's error; "" if none of these."""
+    if not folder.is_dir():
+        return ""
+    tutorial = "docs/tutorials.md, 'The case.toml a user writes'"
+    if (folder / "CFD" / "constant" / "couplingProperties").is_file():
+        return (f"; {folder} is a CFDEM tutorial: its case.toml goes into CFD/, and 'python -m pyhost run "
+                f"{folder / 'CFD'}' runs it ({tutorial})")
+    if (folder / "constant" / "couplingProperties").is_file():
+        scripts = sorted(p.name for p in (folder.parent / "DEM").glob("in.*"))
+        script = next((n for n in scripts if "run" in n), scripts[0] if scripts else "in.liggghts_run")
+        return (f"; {folder} is a CFDEM case's OpenFOAM folder: write case.toml here with [dem] script = "
+                f"\"../DEM/{script}\", [effects] fluid = true, [fluid] case = \".\" and the particles' real "
+                f"material ({tutorial})")
+    if (folder / "constant" / "kinematicCloudProperties").is_file():
+        return (f"; {folder} is an OpenFOAM particle case: 'python -m pyhost dpmfoam {folder} OUT' writes a "
+                "DPMFoam case as a case of the host (docs/dpmfoam.md)")
+    scripts = sorted(p.name for p in folder.glob("in.*") if p.is_file())
+    if scripts:
+        return (f"; {folder} holds the LIGGGHTS script{'s' if len(scripts) > 1 else ''} {', '.join(scripts)}: write "
+                f"case.toml beside it with [dem] script = \"{scripts[0]}\", the collision heat ([effects] "
+                f"contact_heat = \"A\") and the particles' real material ({tutorial})")
+    return ""
+
+
 def read_toml(path) -> dict:
     """The tables of a scene file; SceneError if it is missing, not text or not TOML."""
     try:
         return tomllib.loads(read_text(Path(path)))
     except FileNotFoundError:
-        raise SceneError(f"{path}: no such scene file") from None
+        raise SceneError(f"{path}: no such scene file{what_is_here(Path(path).parent)}") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML: {exc}") from None
 

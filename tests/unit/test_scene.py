@@ -140,3 +140,25 @@ def test_a_variable_name_liggghts_cannot_take_is_refused(tmp_path):
                                         'conductivity = 1.0\n')
     with pytest.raises(SceneError, match=r"dem.test_variables: 'n fill' is not a LIGGGHTS variable name"):
         load_scene(tmp_path / "case.toml")
+
+
+@pytest.mark.parametrize("files, where, words", [
+    (["CFD/constant/couplingProperties", "DEM/in.liggghts_init", "DEM/in.liggghts_run"], ".",
+     ["is a CFDEM tutorial: its case.toml goes into CFD/"]),
+    (["CFD/constant/couplingProperties", "DEM/in.liggghts_init", "DEM/in.liggghts_run"], "CFD",
+     ["is a CFDEM case's OpenFOAM folder", 'script = "../DEM/in.liggghts_run"', 'case = "."']),
+    (["constant/kinematicCloudProperties", "system/controlDict"], ".", ["python -m pyhost dpmfoam"]),
+    (["in.packing", "post/x"], ".", ['holds the LIGGGHTS script in.packing', 'script = "in.packing"']),
+    (["notes.txt"], ".", []),
+])
+def test_a_missing_scene_file_says_what_the_folder_is(tmp_path, files, where, words):
+    """'python -m pyhost run FOLDER' on a tutorial as it is (no case.toml yet): the error names
+    what the folder holds and how it becomes a case of the host."""
+    for f in files:
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / f).write_text("")
+    with pytest.raises(SceneError) as err:
+        load_scene(tmp_path / where / "case.toml")
+    message = str(err.value)
+    assert message.startswith(f"{tmp_path / where / 'case.toml'}: no such scene file")
+    assert all(w in message for w in words) and (words or message.endswith("no such scene file")), message
