@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import re
 import tomllib
 from pathlib import Path
@@ -142,11 +143,9 @@ def what_is_here(folder: Path) -> str:
         return (f"; {folder} is a CFDEM tutorial: its case.toml goes into CFD/, and 'python -m pyhost run "
                 f"{folder / 'CFD'}' runs it ({tutorial})")
     if (folder / "constant" / "couplingProperties").is_file():
-        scripts = sorted(p.name for p in (folder.parent / "DEM").glob("in.*"))
-        script = next((n for n in scripts if "run" in n), scripts[0] if scripts else "in.liggghts_run")
-        return (f"; {folder} is a CFDEM case's OpenFOAM folder: write case.toml here with [dem] script = "
-                f"\"../DEM/{script}\", [effects] fluid = true, [fluid] case = \".\" and the particles' real "
-                f"material ({tutorial})")
+        return (f"; {folder} is a CFDEM case's OpenFOAM folder: write case.toml here with [effects] fluid = true, "
+                f"[fluid] case = \".\" and the particles' real material (the script is the one its "
+                f"couplingProperties names; {tutorial})")
     if (folder / "constant" / "kinematicCloudProperties").is_file():
         return (f"; {folder} is an OpenFOAM particle case: 'python -m pyhost dpmfoam {folder} OUT' writes a "
                 "DPMFoam case as a case of the host (docs/dpmfoam.md)")
@@ -176,7 +175,7 @@ def load_scene(path) -> Scene:
     for key in data:
         if key not in SECTIONS:
             raise SceneError(f"{file}: {key}: unknown section; known: {', '.join(SECTIONS)}")
-    dem = build(Dem, data.get("dem", {}), "dem", file)
+    dem = _cfdem_script(build(Dem, data.get("dem", {}), "dem", file), data, path, file)
     scripted = bool(dem.script)
     required = ("materials",) if scripted else ("materials", "particles", "domain", "time")
     for key in required:
@@ -241,6 +240,24 @@ def load_scene(path) -> Scene:
     scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem)
     check_scene(scene)
     return scene
+
+
+def _cfdem_script(dem, data, path, file):
+    """A CFDEM case names the LIGGGHTS script its coupling runs (``coupling_script``): the
+    scene's dem.script when the scene gives none and places no particles of its own."""
+    fluid = data.get("fluid")
+    case = fluid.get("case") if isinstance(fluid, dict) else None
+    if dem.script or "particles" in data or not isinstance(case, str) or not case:
+        return dem
+    from pyhost.engines.fluid_case import coupling_script
+
+    found = coupling_script(path.resolve().parent / case)
+    if found is None:
+        return dem
+    script, where = found
+    if not script.is_file():
+        raise SceneError(f"{file}: dem.script: not given, and {where} names {script}, which does not exist")
+    return dataclasses.replace(dem, script=os.path.relpath(script, path.resolve().parent))
 
 
 def _script_keys(dem, path, file):

@@ -226,7 +226,9 @@ class Fluid:
 @dataclass(frozen=True)
 class Dem:
     script: str = spec(default="", doc="the user's LIGGGHTS input script, relative to the case folder; "
-                                       "run as written, each 'run N' becoming N coupled steps")
+                                       "run as written, each 'run N' becoming N coupled steps; a CFDEM "
+                                       "case's fluid.case without [[particles]]: the script its "
+                                       "couplingProperties names (liggghtsPath) when not given")
     variables: dict = spec(default={}, doc="LIGGGHTS index variables set as with 'liggghts -var NAME VALUE'")
     test_variables: dict = spec(default={}, doc="variables of the -test smoke run (added to variables)")
 

@@ -305,15 +305,11 @@ conductivity = 1.0
 """
 
 
-def cfdem_scene(density: float, *, cp: float = 840.0, T: float = 300.0, effects: str = "",
-                script: str = "in.liggghts_run") -> str:
+def cfdem_scene(density: float, *, cp: float = 840.0, T: float = 300.0, effects: str = "") -> str:
     """The case.toml a user writes into a CFDEM tutorial's CFD/ folder (docs/tutorials.md): the
-    drag law and void fraction model come from its couplingProperties, the coupling interval
-    from its script's fix couple/cfd."""
-    return f"""[dem]
-script = "../DEM/{script}"   # run from CFD/, as CFDEM runs LIGGGHTS
-
-[effects]
+    script, drag law, void fraction model and coupling interval come from its
+    couplingProperties (or the interval from its script's fix couple/cfd)."""
+    return f"""[effects]
 fluid = true
 {effects}
 [fluid]
@@ -345,7 +341,7 @@ TUTORIALS = [
              native_first=("DEM", "in.liggghts_init"), then=("--restart", "--extend", "0.05"),
              checks=ergun_restart_checks),
     Tutorial("periodicChannel", "cfdem", "tutorials/cfdemSolverPiso/periodicChannel", "CFD",
-             cfdem_scene(2000.0, script="in.liggghts_resume"),
+             cfdem_scene(2000.0),
              changes=[drop_line("DEM/in.liggghts_resume", "processors", "it asks for 4 ranks; the host runs on 1")],
              native_first=("DEM", "in.liggghts_init"), checks=periodic_checks),
     Tutorial("packedBedTemp", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",

@@ -15,6 +15,7 @@ at ``T_inlet``, outlets zeroGradient (T0 for backflow), walls adiabatic unless
 """
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -231,6 +232,18 @@ CFDEM_KNOWN = {"fluid.drag": CFDEM_DRAG, "fluid.void_fraction": CFDEM_VOID_FRACT
 """The scene keys a CFDEM model name goes to, with the names the host has."""
 
 
+def _entry(f, name: str):
+    """A dictionary's entry ``name`` as OpenFOAM finds it: the key itself, else the last
+    "(regex)" key that matches it whole (ErgunTestMPI: ``"(twoWayMPIProps|M2MProps)"``)."""
+    if name in f:
+        return f[name]
+    for key in reversed(list(f.keys())):
+        k = str(key)
+        if k.startswith('"') and k.endswith('"') and re.fullmatch(k[1:-1], name):
+            return f[key]
+    return None
+
+
 def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     """What a CFDEM case's constant/couplingProperties says that a scene key also says, by
     scene key: ``{"fluid.drag": (entry, CFDEM's value, the host's value or None where it has
@@ -258,7 +271,7 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     model = f.get("voidFractionModel")
     if model is not None:
         found["fluid.void_fraction"] = ("voidFractionModel", str(model), CFDEM_VOID_FRACTION.get(str(model)))
-        floor = (f.get(f"{model}Props") or {}).get("alphaMin")
+        floor = (_entry(f, f"{model}Props") or {}).get("alphaMin")
         if str(model) in CFDEM_VOID_FRACTION:   # (CFDEM's divided and centre clip at alphaMin, default 0.1)
             found["fluid.alpha_min"] = ((f"{model}Props alphaMin", f"{floor:g}", float(floor)) if floor is not None
                                         else (f"{model}Props", "no alphaMin: CFDEM's default 0.1", CFDEM_ALPHA_MIN))
@@ -272,7 +285,7 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     for heat in ("LaEuScalarTemp", "scalarGeneralExchange"):
         if heat not in models:
             continue
-        props = f.get(f"{heat}Props") or {}
+        props = _entry(f, f"{heat}Props") or {}
         if heat == "LaEuScalarTemp":
             nusselt = str(props.get("NuCorrelation", "LiMason")).strip('"')
         else:
@@ -284,6 +297,21 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
                 found[key] = (f"{heat}Props {entry}", f"{props[entry]:g}", float(props[entry]))
         break
     return found
+
+
+def coupling_script(case: str | Path) -> tuple[Path, str] | None:
+    """The LIGGGHTS script a CFDEM case's coupling runs (its dataExchangeModel's Props
+    ``liggghtsPath``, relative to the case folder, where CFDEM runs LIGGGHTS) and where that
+    is said; None without one."""
+    path = Path(case) / "constant" / "couplingProperties"
+    if not path.is_file():
+        return None
+    f = FoamFile(path)
+    exchange = str(f.get("dataExchangeModel", ""))
+    script = (_entry(f, f"{exchange}Props") or {}).get("liggghtsPath")
+    if not script:
+        return None
+    return Path(case) / str(script).strip('"'), f"{path} {exchange}Props liggghtsPath"
 
 
 def cfdem_unsupported(case: str | Path) -> str | None:
@@ -301,7 +329,7 @@ def cfdem_unsupported(case: str | Path) -> str | None:
         where = f"voidFractionModel {model}" if model in ("IB", "bigParticle") else f"forceModels {' '.join(forces)}"
         return (f"the case resolves its particles on the mesh (an immersed boundary, as cfdemSolverIB: {coupling} "
                 f"{where}); the host couples particles smaller than the cells, through a fluid fraction and a drag law")
-    exchange = f.get("scalarGeneralExchangeProps") or {}
+    exchange = _entry(f, "scalarGeneralExchangeProps") or {}
     species = [(str(name), f"{coupling} scalarGeneralExchangeProps partSpeciesNames")
                for name in exchange.get("partSpeciesNames") or [] if str(name) != "none"]
     transport = Path(case) / "constant" / "scalarTransportProperties"
@@ -309,7 +337,7 @@ def cfdem_unsupported(case: str | Path) -> str | None:
         t = FoamFile(transport)
         kind = str(t.get("scalarTransportModel", ""))
         species = [(str(name), f"{transport} {kind}Props eulerianFields")
-                   for name in (t.get(f"{kind}Props") or {}).get("eulerianFields") or [] if str(name) != "T"] + species
+                   for name in (_entry(t, f"{kind}Props") or {}).get("eulerianFields") or [] if str(name) != "T"] + species
     if species:
         names = ", ".join(sorted({name for name, _ in species}))
         return (f"the case transports species ({names}: {species[0][1]}); the host solves the gas flow and temperature "

@@ -247,3 +247,28 @@ def test_cfdem_script_ending_in_run_1_is_driven_and_extends(tmp_path):
         np.testing.assert_allclose(got[name], want[name], rtol=1e-6, atol=0, equal_nan=True, err_msg=name)
     assert got_summary["steps"] == want_summary["steps"] == 2000
     assert got_summary["time"] == want_summary["time"]
+
+
+def test_the_script_is_the_one_the_coupling_names(tmp_path):
+    """A CFDEM case names the script its coupling runs (couplingProperties' twoWayMPIProps
+    liggghtsPath, relative to CFD/, or under a "(regex)" key as ErgunTestMPI has it): a
+    case.toml without [dem] takes it (periodicChannel's is in.liggghts_resume), and one that
+    names none that exists is refused, naming the entry."""
+    from pyhost.scene import SceneError, load_scene
+
+    cfd = cfdem_case(tmp_path)
+    toml = cfd / "case.toml"
+    toml.write_text(toml.read_text().replace('[dem]\nscript = "../DEM/in.liggghts_run"\n', ""))
+    (cfd.parent / "DEM" / "in.liggghts_run").rename(cfd.parent / "DEM" / "in.liggghts_resume")
+    coupling = cfd / "constant" / "couplingProperties"
+    coupling.write_text('FoamFile\n{\n    version 2.0;\n    format ascii;\n    class dictionary;\n    object '
+                        'couplingProperties;\n}\ndataExchangeModel twoWayMPI;\ncouplingInterval 100;\n'
+                        'twoWayMPIProps\n{\n    liggghtsPath "../DEM/in.liggghts_resume";\n}\n')
+    assert load_scene(toml).dem.script == "../DEM/in.liggghts_resume"
+    # ErgunTestMPI's form: one dictionary for two exchange models, under a regular expression key
+    coupling.write_text(coupling.read_text().replace("twoWayMPIProps\n", '"(twoWayMPIProps|M2MProps)"\n'))
+    assert load_scene(toml).dem.script == "../DEM/in.liggghts_resume"
+    coupling.write_text(coupling.read_text().replace("in.liggghts_resume", "in.liggghts_gone"))
+    with pytest.raises(SceneError, match=r"dem.script: not given, and .*couplingProperties twoWayMPIProps "
+                                         r"liggghtsPath names .*in.liggghts_gone, which does not exist"):
+        load_scene(toml)

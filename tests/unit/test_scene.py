@@ -146,7 +146,7 @@ def test_a_variable_name_liggghts_cannot_take_is_refused(tmp_path):
     (["CFD/constant/couplingProperties", "DEM/in.liggghts_init", "DEM/in.liggghts_run"], ".",
      ["is a CFDEM tutorial: its case.toml goes into CFD/"]),
     (["CFD/constant/couplingProperties", "DEM/in.liggghts_init", "DEM/in.liggghts_run"], "CFD",
-     ["is a CFDEM case's OpenFOAM folder", 'script = "../DEM/in.liggghts_run"', 'case = "."']),
+     ["is a CFDEM case's OpenFOAM folder", "fluid = true", 'case = "."', "the one its couplingProperties names"]),
     (["constant/kinematicCloudProperties", "system/controlDict"], ".", ["python -m pyhost dpmfoam"]),
     (["in.packing", "post/x"], ".", ['holds the LIGGGHTS script in.packing', 'script = "in.packing"']),
     (["notes.txt"], ".", []),
