@@ -619,12 +619,12 @@ class Post:
             progress = Progress(float("inf"), self.progress_every)
             for f in self.frames(self.reader(self.dumps, require=ATOMS_REQUIRED)):
                 progress.update(f.time, f"; replaying the dumps: heat of {done} of {n} collisions moved")
+                between = []
                 while sets and sets[0][0] < f.step:
-                    if before is None:          # before the first frame: in the first appearances' temperatures
-                        sets.pop(0)
-                        continue
-                    upto(sets[0][0])            # what collided before the script's set, then the set
-                    self.follow_set(sets.pop(0), before, f, T)
+                    between.append(sets.pop(0))
+                if between and before is not None:  # (before the first frame: in the first appearances' temperatures)
+                    upto(between[0][0])         # what collided before the script's sets, then the sets
+                    self.follow_sets(between, before, f, T)
                 upto(f.step)
                 column = self.temperature_column(f)
                 before = (f.step, f["id"].astype(np.int64), f[column] if column else None)
@@ -653,16 +653,16 @@ class Post:
             self.summary["picture"] = str(plot_post(self.out, last, [f"{a}-{b or 'wall'}" for a, b in pairs],
                                                     times, pair_heat))
 
-    def follow_set(self, temperature_set, before, f, T) -> None:
-        """A script's ``set ... property/atom Temp`` at a step between two frames: each
-        particle's temperature in every model changes by what the dumps' temperature changed
-        between the frames (which holds the set and the script's own conduction over those
-        steps: heat/gran's, if any). Listed in summary.json's ``temperature_sets``."""
-        step, where, command = temperature_set
+    def follow_sets(self, temperature_sets, before, f, T) -> None:
+        """A script's ``set ... property/atom Temp`` commands between two frames: each
+        particle's temperature in every model changes once by what the dumps' temperature
+        changed between the frames (which holds the sets and the script's own conduction over
+        those steps: heat/gran's, if any). Listed in summary.json's ``temperature_sets``."""
+        said = [f"{where}: {command}" for _, where, command in temperature_sets]
         column = self.temperature_column(f)
         if before[2] is None or column is None:
-            self.warnings.append(f"{where}: '{command}' at step {step}: the dumps have no particle temperature "
-                                 "(f_Temp), so post's temperatures do not follow it")
+            self.warnings.append(f"{'; '.join(said)}: the dumps have no particle temperature (f_Temp), so post's "
+                                 "temperatures do not follow it")
             return
         ids0, T0 = before[1], before[2]
         ids = f["id"].astype(np.int64)
@@ -674,8 +674,8 @@ class Post:
             T[m][ids[both]] += change
         moved = np.abs(change) > 0
         self.summary.setdefault("temperature_sets", []).append(dict(
-            step=step, where=where, command=command, frames=[before[0], f.step], particles_changed=int(moved.sum()),
-            mean_change_K=float(change[moved].mean()) if moved.any() else 0.0))
+            steps=[step for step, _, _ in temperature_sets], commands=said, frames=[before[0], f.step],
+            particles_changed=int(moved.sum()), mean_change_K=float(change[moved].mean()) if moved.any() else 0.0))
 
     def initial_temperatures(self, known, mat) -> np.ndarray:
         T0 = np.full(len(self.particles.type), np.nan)

@@ -211,22 +211,25 @@ def test_a_scripts_set_of_temperatures_is_followed(tmp_path):
     """A script that sets particles' Temp between runs (Debian's heatTransfer tutorials heat half
     their bed after it settles): post's temperatures change by what the dumps' temperature
     changed across the set, so a pair meeting after it moves heat from 400 K to 250 K: three times
-    what the same dumps give without the set (particle 1 kept its first appearance's 300 K); a
-    set before the first run is in the first frame already."""
+    what the same dumps give without the set (particle 1 kept its first appearance's 300 K); two
+    sets between the same frames change the temperatures once; a set before the first run is
+    in the first frame already."""
     script = tmp_path / "in.heat"
     script.write_text("timestep 1e-6\nset atom 2 property/atom Temp 250\nrun 10 upto\n"
-                      "set atom 1 property/atom Temp 400 # the hot one\nrun 20 upto\n")
+                      "set atom 1 property/atom Temp 400 # the hot one\nset atom 2 property/atom Temp 250\n"
+                      "run 20 upto\n")
     hot_and_cold(tmp_path, hot_from=20)
     run = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--script", script, "--out", tmp_path / "out")
     assert run.returncode == 0, run.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     [done] = summary["temperature_sets"]
-    assert (done["step"], done["frames"], done["particles_changed"], done["mean_change_K"]) == (10, [10, 20], 1, 100.0)
-    assert done["where"].endswith("in.heat: line 4")
+    assert (done["steps"], done["frames"], done["particles_changed"], done["mean_change_K"]) == ([10, 10], [10, 20],
+                                                                                                 1, 100.0)
+    assert done["commands"][0].endswith("in.heat: line 4: set atom 1 property/atom Temp 400")
     [row] = rows(tmp_path / "out")
     assert (row["i"], row["j"], float(row["time"])) == ("1", "2", pytest.approx(2e-5)) and float(row["Q_A"]) > 0
     assert summary["heat_J"]["A"] == pytest.approx(float(row["Q_A"]))
-    script.write_text(script.read_text().replace("set atom 1", "# set atom 1"))
+    script.write_text("timestep 1e-6\nset atom 2 property/atom Temp 250\nrun 10 upto\nrun 20 upto\n")   # no set
     unset = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--script", script, "--out", tmp_path / "b")
     assert unset.returncode == 0, unset.stderr
     assert float(row["Q_A"]) == pytest.approx(3.0 * float(rows(tmp_path / "b")[0]["Q_A"]), rel=1e-9)
