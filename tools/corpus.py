@@ -7,7 +7,9 @@ twoSpheresGlowinskiMPI, whose particles the mesh resolves, and voidfractionTest,
 solved, and ErgunTestMPI_cgs, in cgs units, must be refused), and Debian's liggghts-doc tutorials (packing,
 heatTransfer_1 and _2, chute_wear, conveyor, meshGran, movingMeshGran, insert_stream and its
 restart, mesh_tet, hysteresis, cohesion, contactModels, hydrogel_multicontact's default), and
-Debian's openfoam-examples DPMFoam tutorial, Goldschmidt, after ``python -m pyhost dpmfoam``.
+Debian's openfoam-examples DPMFoam tutorial, Goldschmidt, after ``python -m pyhost dpmfoam``;
+and ``python -m pyhost post`` on the dumps of two of Debian's tutorials run natively
+(post:heatTransfer_1, which heats half its bed mid-run, and post:chute_wear).
 
 The tutorials are not part of this repository (their licences are theirs, and fetched
 content is never committed): point ``--cfdem`` at a CFDEMcoupling-PUBLIC checkout; Debian's
@@ -27,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import gzip
 import json
 import math
 import os
@@ -93,6 +96,8 @@ class Tutorial:
     checks: Callable | None = None    # (copy, out) -> list[Check]
     refused: str = ""                 # an input the host must refuse: its words (exit 2)
     ranks: int = 1                    # > 1: the native stage and the host under mpirun (its processors line kept)
+    post: tuple = ()                  # 'python -m pyhost post' on the native stage's dumps instead of run: its
+                                      # arguments, relative to the case folder (where it runs)
 
 
 def drop_line(script: str, pattern: str, why: str):
@@ -276,6 +281,37 @@ def periodic_checks(w: Path, out: Path) -> list[Check]:
             Check("gas flow through the walls [m^3/s]", last("volFlow_wall"), 0.0, 1e-9, relative=False)]
 
 
+def post_checks(pattern: str):
+    """post on a native run's dumps (``pattern``, in the tutorial's folder): it read every dump
+    file, and the last frame has as many particles as LIGGGHTS' own last thermo line (its
+    atoms column) says."""
+    def checks(w: Path, out: Path) -> list[Check]:
+        s = summary(out)
+        log = (w / "log.liggghts").read_text().splitlines()
+        head = max(k for k, line in enumerate(log) if line.split()[:2] == ["Step", "Atoms"])
+        rows = [line.split() for line in log[head + 1:] if line.split() and line.split()[0].isdigit()]
+        return [Check("frames read = dump files", s["frames"], len(list(w.glob(pattern))), 0, relative=False),
+                Check("particles in the last frame (LIGGGHTS' atoms)", s["particles"], float(rows[-1][1]), 0,
+                      relative=False)]
+    return checks
+
+
+def post_set_checks(w: Path, out: Path) -> list[Check]:
+    """heatTransfer_1's dumps: post follows the script's 'set region halfbed property/atom Temp
+    800.' at step 20,000; before it every particle is at 300 K, so no collision moves heat, and
+    after it collisions between the halves do."""
+    s = summary(out)
+    with gzip.open(out / "collisions.csv.gz", "rt") as f:
+        rows = [(float(r["time"]), abs(float(r["Q_A"]))) for r in csv.DictReader(f)]
+    before = sum(q for t, q in rows if t < 20000 * 2.5e-5 - 1e-12)
+    after = sum(q for t, q in rows if t >= 20000 * 2.5e-5 - 1e-12)
+    sets = s.get("temperature_sets", [])
+    return post_checks("post/heatGran_[0-9]*.vtk")(w, out) + [
+        Check("step of the Temp set followed", sets[0]["steps"][0] if sets else math.nan, 20000, 0, relative=False),
+        Check("collision heat before the set, model A [J]", before, 0.0, 0, relative=False),
+        Check("collision heat after the set > 0, model A", float(after > 0), 1.0, 0, relative=False)]
+
+
 def liggghts_checks(w: Path, out: Path) -> list[Check]:
     return [balance_check(out)]
 
@@ -374,6 +410,13 @@ TUTORIALS = [
              checks=liggghts_checks),
     Tutorial("Goldschmidt", "openfoam", "lagrangian/DPMFoam/Goldschmidt", "host", "",       # DPMFoam's own
              changes=[dpmfoam_import(0.05)], checks=goldschmidt_checks),
+    Tutorial("post:heatTransfer_1", "liggghts", "heatTransfer_1", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0,
+                                                                                    T=0.0),
+             native_first=(".", "in.heatGran"), checks=post_set_checks,
+             post=("post/heatGran_[0-9]*.vtk", "--scene", "case.toml", "--script", "in.heatGran")),
+    Tutorial("post:chute_wear", "liggghts", "chute_wear", ".", liggghts_scene("in.chute_wear", 2500.0),
+             native_first=(".", "in.chute_wear"), checks=post_checks("post/chute_[0-9]*.vtk"),
+             post=("post/chute_[0-9]*.vtk", "--scene", "case.toml", "--script", "in.chute_wear")),
 ] + [Tutorial(name, "liggghts", folder, ".", liggghts_scene(script, density), checks=liggghts_checks)
      for name, folder, script, density in (          # Debian's, run as they are; density = the script's
          ("packing", "packing", "in.packing", 2500.0),
@@ -443,9 +486,11 @@ def main(argv=None) -> int:
             run_native(copy, *tut.native_first, ranks=tut.ranks)
         case, out = copy / tut.case_dir, copy / "host-output"
         cmd = mpirun(tut.ranks) + [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(out), "--overwrite"]
+        if tut.post:                        # post on the native stage's dumps, from the case folder
+            cmd = [sys.executable, "-m", "pyhost", "post", *tut.post, "--out", str(out)]
         start = time.perf_counter()
-        r = subprocess.run(cmd + (["--test"] if args.test else []), cwd=ROOT, capture_output=True, text=True,
-                           env=MPI_ENV)
+        r = subprocess.run(cmd + (["--test"] if args.test and not tut.post else []), cwd=case if tut.post else ROOT,
+                           capture_output=True, text=True, env={**MPI_ENV, "PYTHONPATH": str(ROOT)})
         log = r.stdout + r.stderr
         if tut.then and r.returncode == 0:                # the tutorial's second stage
             cmd = [a for a in cmd if a != "--overwrite"] + list(tut.then)
