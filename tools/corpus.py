@@ -363,27 +363,22 @@ TUTORIALS = [
     Tutorial("settlingTestMPI", "cfdem", "tutorials/cfdemSolverPiso/settlingTestMPI", "CFD",
              cfdem_scene(3000.0), checks=settling_checks),     # DEM/post: the host makes it
     Tutorial("ErgunTestMPI", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI", "CFD",
-             cfdem_scene(2000.0),
-             changes=[drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1")],
+             cfdem_scene(2000.0),          # its 'processors 2 2 1' (4 ranks): the host leaves it out on 1
              native_first=("DEM", "in.liggghts_init"), checks=ergun_checks),
     Tutorial("ErgunTestMPI_np4", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI", "CFD",
              cfdem_scene(2000.0),          # as it is, on its 4 ranks
              native_first=("DEM", "in.liggghts_init"), ranks=4, checks=ergun_checks),
     Tutorial("ErgunTestMPI_restart", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI_restart", "CFD",
              cfdem_scene(2000.0) + "\n[output]\ncheckpoint = 0.01\npictures = false\n",
-             changes=[drop_line("DEM/in.liggghts_run", "processors", "it asks for 4 ranks; the host runs on 1"),
-                      copy_file("CFD/system/controlDict_run", "CFD/system/controlDict"),
+             changes=[copy_file("CFD/system/controlDict_run", "CFD/system/controlDict"),
                       copy_file("CFD/constant/couplingProperties_run", "CFD/constant/couplingProperties")],
              native_first=("DEM", "in.liggghts_init"), then=("--restart", "--extend", "0.05"),
              checks=ergun_restart_checks),
     Tutorial("periodicChannel", "cfdem", "tutorials/cfdemSolverPiso/periodicChannel", "CFD",
-             cfdem_scene(2000.0),
-             changes=[drop_line("DEM/in.liggghts_resume", "processors", "it asks for 4 ranks; the host runs on 1")],
-             native_first=("DEM", "in.liggghts_init"), checks=periodic_checks),
+             cfdem_scene(2000.0), native_first=("DEM", "in.liggghts_init"), checks=periodic_checks),
     Tutorial("packedBedTemp", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),    # its LaEuScalarTemp: li_mason
-             changes=[drop_line("DEM/in.liggghts_run", "processors", "it asks for 2 ranks; the host runs on 1"),
-                      drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks")],
+             changes=[drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks; plain LIGGGHTS runs on 1")],
              native_first=("DEM", "in.liggghts_init"), checks=packed_bed_checks),
     Tutorial("packedBedTemp_np2", "cfdem", "tutorials/cfdemSolverPisoScalar/packedBedTemp", "CFD",
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),   # as it is, on its 2 ranks

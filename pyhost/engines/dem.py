@@ -38,15 +38,10 @@ t_coll up to this many steps is taken back whole (a longer one: its first 200 st
 as heat_gran_undo_cut)."""
 
 
-def refusal_hint(cmd: Command, message: str, ranks: int) -> str:
-    """What a user of a CFDEM tutorial does about two of LIGGGHTS' refusals of its scripts
-    as they are (docs/tutorials.md), appended to the refusal: a processor grid for another
-    number of ranks, and the restart that the tutorial's first stage writes."""
+def refusal_hint(cmd: Command, message: str) -> str:
+    """What a user of a CFDEM tutorial does about LIGGGHTS' refusal of a ``read_restart`` of
+    the file the tutorial's first stage writes (docs/tutorials.md), appended to the refusal."""
     w = cmd.words
-    if w[0] == "processors" and "processors !=" in message and all(x.isdigit() for x in w[1:4]):
-        n = int(w[1]) * int(w[2]) * int(w[3])
-        return (f" (the script's grid is {' x '.join(w[1:4])} = {n} ranks, this run has {ranks}: run it under "
-                f"'mpirun -np {n} python -m pyhost run ...', or delete the line and LIGGGHTS divides the box itself)")
     if w[0] == "read_restart" and "Cannot open restart file" in message:
         first = sorted(p.name for p in Path(cmd.file).parent.glob("in.*init*"))
         if first:
@@ -103,13 +98,28 @@ class Dem:
                 folder.mkdir(parents=True)
                 self.log(f"made the folder {folder.resolve()} for {name} ({cmd.where()}): LIGGGHTS does not make it")
 
+    def foreign_grid(self, cmd: Command) -> bool:
+        """Whether a command is a ``processors Px Py Pz`` for another number of ranks than this
+        run has (CFDEM's tutorials ask for 4 and 2): LIGGGHTS would refuse it ('Specified
+        processors != physical processors'), and it only divides the box among the ranks, the
+        same physics on any grid, so the host leaves it out and says so."""
+        w = cmd.words
+        if w[0] != "processors" or len(w) < 4 or not all(x.isdigit() for x in w[1:4]):
+            return False
+        n, ranks = int(w[1]) * int(w[2]) * int(w[3]), 1 if self.link is None else self.link.size
+        if n == ranks:
+            return False
+        self.log(f"{cmd.where()}: '{cmd.text}' is a grid of {n} ranks and this run has {ranks}: left out (it only "
+                 f"divides the box among the ranks, and LIGGGHTS divides it itself); run under 'mpirun -np {n}' to "
+                 "keep it")
+        return True
+
     def command(self, cmd: Command) -> None:
         """Run one script command; a refusal names the script's file and line."""
         try:
             self._raw(cmd.text)
         except LiggghtsError as exc:
-            ranks = 1 if self.link is None else self.link.size
-            raise LiggghtsError(f"{cmd.where()}: {exc}{refusal_hint(cmd, str(exc), ranks)}") from None
+            raise LiggghtsError(f"{cmd.where()}: {exc}{refusal_hint(cmd, str(exc))}") from None
         self.info.learn(cmd)
         self.report_warnings(cmd)
 
@@ -118,6 +128,7 @@ class Dem:
         run tries them together first in one forked copy (each is otherwise tried alone: see
         ``Liggghts.try_ahead``), the folders of the files they open made first; a refusal names
         the script's file and line."""
+        cmds = [cmd for cmd in cmds if not self.foreign_grid(cmd)]
         for cmd in cmds:
             self.make_folders(cmd)
         if self.link is None:

@@ -360,18 +360,26 @@ def test_an_error_of_one_rank_names_the_script_line(tmp_path):
     assert "Substitution for illegal variable" in r.stderr
 
 
-@pytest.mark.parametrize("first, words", [
-    ("processors 2 2 1\n", ["in.run:1", "Specified processors != physical processors",
-                            "the script's grid is 2 x 2 x 1 = 4 ranks, this run has 1", "mpirun -np 4"]),
-    ("read_restart post/restart/liggghts.restart\n", ["Cannot open restart file",
-                                                      "run 'liggghts -in in.liggghts_init'"]),
-])
-def test_a_cfdem_tutorials_first_stage_and_ranks_are_named(tmp_path, first, words):
-    """Two refusals a CFDEM tutorial run as it is meets (docs/tutorials.md): a processor grid
-    for 4 ranks on 1, and a read_restart of the file its first stage (in.liggghts_init, plain
-    LIGGGHTS) writes; exit 2, LIGGGHTS' message and what to do."""
+def test_a_cfdem_tutorials_first_stage_is_named(tmp_path):
+    """A read_restart of the file a CFDEM tutorial's first stage (in.liggghts_init, plain
+    LIGGGHTS) writes, run before that stage: exit 2, LIGGGHTS' message and what to do."""
     (tmp_path / "in.liggghts_init").write_text("# the tutorial's first stage\n")
-    r, _ = run(tmp_path, first + header() + "run 10\n", toml())      # refused at its first line
+    r, _ = run(tmp_path, "read_restart post/restart/liggghts.restart\n" + header() + "run 10\n", toml())
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
-    for w in words:
+    for w in ("in.run:1", "Cannot open restart file", "run 'liggghts -in in.liggghts_init'"):
         assert w in r.stderr, (w, r.stderr[-2000:])
+
+
+def test_a_processor_grid_for_other_ranks_is_left_out(tmp_path):
+    """'processors 2 2 1' (ErgunTestMPI's, for 4 ranks) on one rank, which LIGGGHTS refuses:
+    the host leaves it out, says so, and the run ends as without it (the grid only divides
+    the box among ranks): the same collisions as without it."""
+    script = header() + "fix gravi all gravity 9.81 vector 0 0 -1\nrun 4000\n"       # the 40 beads land
+    r, with_grid = run(tmp_path, "processors 2 2 1\n" + script, toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "in.run:1: 'processors 2 2 1' is a grid of 4 ranks and this run has 1: left out" in r.stdout
+    plain = tmp_path / "plain"
+    plain.mkdir()
+    r, without = run(plain, script, toml())
+    assert r.returncode == 0 and with_grid["collisions"] > 20
+    assert with_grid["collisions"] == without["collisions"] and with_grid["particle_wall"] == without["particle_wall"]
