@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pyhost.script import Command, ScriptError, ScriptInfo
 from pyhost.walls import PRIMITIVES
 
 
@@ -210,13 +211,17 @@ def read_script(path) -> Script:
         raise ValueError(f"{path}: cannot read the LIGGGHTS script: {exc.strerror}") from None
     timestep, computes, walls, warnings = None, {}, [], []
     setup, heat_gran, primitives, literal = [], [], {}, True
-    globals_, wall_types, mesh_types = {}, {}, {}
+    globals_, info = {}, ScriptInfo()      # info: the walls and their atom types, as a run learns them
     step, temperature_sets, ran = 0, [], False    # the step reached (None: unknown, a $variable); any run yet
     for number, line in _joined(text):
         words = line.split("#")[0].split()
         if not words:
             continue
         where = f"{path}: line {number}: "
+        try:
+            info.learn(Command(" ".join(words), str(path), number))
+        except (ScriptError, ValueError):
+            pass                        # a wall the run would refuse: post places none
         if words[0] in SETUP_COMMANDS:
             setup.append((number, " ".join(words)))
         if words[0] == "timestep" and len(words) > 1:
@@ -228,11 +233,7 @@ def read_script(path) -> Script:
             heat_gran.append(words[1])
         elif words[0] == "fix" and len(words) > 5 and words[3] == "property/global":
             globals_[words[4]] = (where.rstrip(": "), words[5:])
-        elif words[0] == "fix" and len(words) > 3 and words[3].startswith("mesh/surface") and "type" in words[:-1]:
-            mesh_types[words[1]] = words[words.index("type") + 1]
         elif words[0] == "fix" and len(words) > 5 and words[3] == "wall/gran" and "primitive" in words:
-            if "type" in words[:-1]:
-                wall_types[words[1]] = words[words.index("type") + 1]
             kind = next((w for w in words if w in PRIMITIVES), None)
             numbers = words[words.index(kind) + 1:][:PRIMITIVES[kind]] if kind else []
             try:
@@ -245,8 +246,6 @@ def read_script(path) -> Script:
             computes[c.id] = c
         elif words[0] == "fix" and len(words) > 3 and words[3] == "wall/gran" and "mesh" in words:
             walls.append(words[1])
-            if "meshes" in words[:-1]:
-                wall_types[words[1]] = mesh_types.get(words[words.index("meshes") + 1])
         elif words[0] == "include":
             warnings.append(f"{where}include {' '.join(words[1:])} not followed")
         elif words[0] in ("run", "reset_timestep", "read_restart"):
@@ -265,7 +264,7 @@ def read_script(path) -> Script:
                             "give --dt")
         elif not literal:
             timestep = dt
-    wall_types = {fix: int(t) for fix, t in wall_types.items() if t is not None and t.isdigit()}
+    wall_types = {fix: info.wall_type(fix) for fix in info.walls if info.wall_type(fix) is not None}
     return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), primitives, globals_,
                   wall_types, tuple(temperature_sets))
 
