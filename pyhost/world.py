@@ -15,18 +15,20 @@ from pathlib import Path
 import numpy as np
 
 
-def _case_copy_filter(target: Path):
-    """What a copy of a user's OpenFOAM case leaves out: earlier solver output (time folders
-    other than 0, processor folders, logs, the pipes) and the run's own output folder, which
-    lies inside the case when case.toml sits in it (``case = "."``, CFDEM's layout), as do
-    earlier runs' output folders (holding scene.json) written with another --out."""
-    target = Path(target).resolve()
+def _case_copy_filter(target: Path, source: Path, start: str | None = None):
+    """What a copy of a user's OpenFOAM case ``source`` leaves out: earlier solver output (time
+    folders other than 0 and ``start``, the one its controlDict starts from, processor folders,
+    logs, the pipes) and the run's own output folder, which lies inside the case when case.toml
+    sits in it (``case = "."``, CFDEM's layout), as do earlier runs' output folders (holding
+    scene.json) written with another --out."""
+    target, source = Path(target).resolve(), Path(source).resolve()
     solver_output = shutil.ignore_patterns("processor*", ".link", "log.*", "[1-9]*", "0.[0-9]*")
 
     def ignore(folder, names):
         here = Path(folder).resolve()
-        return set(solver_output(folder, names)) | {n for n in names if target.is_relative_to(here / n)
-                                                     or (here / n / "scene.json").is_file()}
+        kept = {start} if here == source else set()
+        return (set(solver_output(folder, names)) - kept) | {n for n in names if target.is_relative_to(here / n)
+                                                             or (here / n / "scene.json").is_file()}
     return ignore
 
 
@@ -64,7 +66,7 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
     from foamlib import FoamFile
 
     from pyhost.engines.fluid_case import (add_final_solvers, adopt_mean_velocity_force, adopt_piso,
-                                           adopt_void_fraction, box_case, case_density)
+                                           adopt_void_fraction, box_case, case_density, start_time)
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
@@ -75,7 +77,8 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
         source = (scene.folder / f.case).resolve()
         earlier = _set_aside_writes(folder, restart)
         shutil.rmtree(folder, ignore_errors=True)
-        shutil.copytree(source, folder, symlinks=True, ignore=_case_copy_filter(folder))
+        shutil.copytree(source, folder, symlinks=True,
+                        ignore=_case_copy_filter(folder, source, None if restart else start_time(source)[1]))
         for p in earlier:
             shutil.move(str(p), folder / p.name)
         if earlier:

@@ -15,6 +15,7 @@ at ``T_inlet``, outlets zeroGradient (T0 for backflow), walls adiabatic unless
 """
 from __future__ import annotations
 
+import math
 import re
 import shutil
 from pathlib import Path
@@ -297,6 +298,28 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
                 found[key] = (f"{heat}Props {entry}", f"{props[entry]:g}", float(props[entry]))
         break
     return found
+
+
+def start_time(case: str | Path) -> tuple[float, str | None]:
+    """The time [s] a case's controlDict starts from (``startFrom startTime``: its startTime;
+    ``latestTime``, ``firstTime``: the case's latest or first time folder, 0 without one) and
+    the case's time folder of that time (None: the case has none, e.g. a CFDEM restart stage
+    whose first stage the host ran, writing its times into its own output)."""
+    case = Path(case)
+    control = FoamFile(case / "system" / "controlDict")
+    times = sorted((float(p.name), p.name) for p in case.iterdir() if p.is_dir() and _time_name(p.name))
+    how = str(control.get("startFrom", "startTime"))
+    if how == "latestTime" or how == "firstTime":
+        return times[-1 if how == "latestTime" else 0] if times else (0.0, None)
+    t = float(getattr(control.get("startTime", 0.0), "value", control.get("startTime", 0.0)))
+    return t, next((name for value, name in times if math.isclose(value, t, rel_tol=1e-9, abs_tol=1e-12)), None)
+
+
+def _time_name(name: str) -> bool:
+    try:
+        return math.isfinite(float(name))
+    except ValueError:
+        return False
 
 
 def coupling_script(case: str | Path) -> tuple[Path, str] | None:

@@ -168,6 +168,33 @@ def check_fv_options(folder: Path, file: str) -> None:
                                  "set twoPhase false")
 
 
+def check_start(folder: Path, file: str) -> None:
+    """A controlDict that starts at another time than 0 (a CFDEM restart stage: ErgunTestMPI_restart's
+    controlDict_restart, startTime 0.05) needs the case's time folder of that time, with U and p:
+    the fluid's state to go on from. A host run writes its fluid's times into its output
+    (OUT/fluid), not into the case: where an output folder in the case has that time, the
+    message says what to copy (output folders in the case and beside it)."""
+    from pyhost.engines.fluid_case import start_time
+
+    t, name = start_time(folder)
+    control = folder / "system" / "controlDict"
+    if name is None and t != 0.0:
+        found = sorted(p for where in (folder, folder.parent) for p in where.glob("*/fluid/*")
+                       if (p.parent.parent / "scene.json").is_file() and re.fullmatch(r"[0-9.eE+-]+", p.name)
+                       and math.isclose(float(p.name), t, rel_tol=1e-9))
+        hint = (f": a run of the host wrote it in {found[-1]}: copy it into the case "
+                f"(cp -r {found[-1]} {folder}/), then run with --overwrite or another --out" if found else
+                ": give the case the fluid's fields at that time (a CFDEM stage before this one writes them), "
+                "or start at 0")
+        raise SceneError(f"{file}: fluid.case: {control} starts at t = {t:g} s, and {folder} has no time folder of "
+                         f"that time{hint}")
+    if name is not None and name != "0":
+        missing = [f for f in ("U", "p") if not (folder / name / f).is_file()]
+        if missing:
+            raise SceneError(f"{file}: fluid.case: {control} starts at t = {t:g} s, and {folder / name} lacks "
+                             f"{', '.join(missing)}")
+
+
 def check_case(folder: Path, file: str, ranks: int, energy: bool) -> None:
     """All the checks of the module doc (the files' presence is checked by the caller)."""
     props = _read(folder, "constant/transportProperties", file)
@@ -178,6 +205,7 @@ def check_case(folder: Path, file: str, ranks: int, energy: bool) -> None:
     if "rho" in props and _number(props["rho"]) is None:
         raise SceneError(f"{where}: rho: must be a number, the gas density in kg/m^3 (e.g. 'rho 1.2;'), "
                          f"got {props['rho']!r}")
+    check_start(folder, file)
     check_fields(folder, file, ("U", "p", "T") if energy else ("U", "p"))
     check_fv_options(folder, file)
     if ranks > 1:

@@ -32,6 +32,7 @@ import numpy as np
 from foamlib import FoamFile
 
 from plugins import drag as drag_laws
+from pyhost.engines.fluid_case import start_time
 
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
 SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[2] / ".setup" / "bin" / "collheatFoam"))
@@ -167,7 +168,7 @@ class FluidSolver:
         self._fds: list[tuple[int, int]] = []
         self._busy = False
         self._pending = False        # an advance sent whose answers are not read yet
-        self._time = 0.0
+        self._time = start_time(self.case)[0]    # s: the controlDict's start (a restart's: its saved time)
         self.restart = None if restart is None else Path(restart)
 
     # -- life cycle -------------------------------------------------------------------

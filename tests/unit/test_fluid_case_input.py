@@ -62,8 +62,47 @@ def test_copy_of_a_case_holding_runs_leaves_them_out(case):
     (case / "processor0").mkdir()
     copy = case / "output" / "fluid"
     shutil.rmtree(copy)
-    shutil.copytree(case, copy, ignore=_case_copy_filter(copy))
+    shutil.copytree(case, copy, ignore=_case_copy_filter(copy, case))
     assert sorted(p.name for p in copy.iterdir()) == ["0", "case.toml", "constant", "system"]
+
+
+def test_a_case_starting_later_starts_from_its_time_folder_and_the_copy_keeps_it(case):
+    """startFrom startTime at 0.05 s (ErgunTestMPI_restart's second stage): the case's folder of
+    that time is the start, kept in the copy where other times are left out; latestTime takes
+    the latest folder; without a folder of that time, the case has none (None)."""
+    import shutil
+
+    from pyhost.engines.fluid_case import start_time
+    from pyhost.world import _case_copy_filter
+    def control(key, value):                # (a FoamFile each time: one kept across writes duplicated an entry)
+        FoamFile(case / "system" / "controlDict")[key] = value
+
+    control("startTime", 0.05)
+    assert start_time(case) == (0.05, None)
+    for t in ("0.05", "0.1"):
+        shutil.copytree(case / "0", case / t)
+    assert start_time(case) == (0.05, "0.05")
+    control("startFrom", "latestTime")
+    assert start_time(case) == (0.1, "0.1")
+    control("startFrom", "startTime")
+    copy = case.parent / "copy"
+    shutil.copytree(case, copy, ignore=_case_copy_filter(copy, case, start_time(case)[1]))
+    assert sorted(p.name for p in copy.iterdir()) == ["0", "0.05", "constant", "system"]
+
+
+def test_a_start_time_without_its_folder_is_refused_naming_what_to_copy(case):
+    """A second stage whose fluid state a run of the host wrote into its own output: exit 2
+    before any engine, with the cp to make (the host writes no time into the user's case)."""
+    from pyhost.engines.foam_case_check import check_start
+    from pyhost.schema import SceneError
+    FoamFile(case / "system" / "controlDict")["startTime"] = 0.05
+    with pytest.raises(SceneError, match="has no time folder of that time: give the case the fluid's fields"):
+        check_start(case, "case.toml")
+    (case / "output" / "fluid" / "0.05").mkdir(parents=True)
+    (case / "output" / "scene.json").write_text("{}")
+    with pytest.raises(SceneError, match=r"starts at t = 0.05 s.*a run of the host wrote it in .*output/fluid/0.05: "
+                                         r"copy it into the case \(cp -r "):
+        check_start(case, "case.toml")
 
 
 def piso_case(case, application, pimple=None):
