@@ -30,6 +30,7 @@ import numpy as np
 from pyhost import checkpoint, signals
 from pyhost.dem_input import script_dem_contacts
 from pyhost.effects.balance import EnergyBalance
+from pyhost.effects.case_commands import CaseCommands, case_commands
 from pyhost.effects.collisions import CollisionHeat
 from pyhost.effects.fluid import FluidExchange
 from pyhost.effects.frames import Frames
@@ -53,7 +54,8 @@ FRAME_EVERY = 1e-3
 def totals() -> dict:
     """The run's totals at its start (summary.json): the ``TOTALS`` of every effect that adds
     to them, present in the scene or not (a summary has the same keys whatever the scene)."""
-    return {key: value for effect in (CollisionHeat, EnergyBalance, FluidExchange) for key, value in effect.TOTALS.items()}
+    return {key: value for effect in (CollisionHeat, EnergyBalance, CaseCommands, FluidExchange)
+            for key, value in effect.TOTALS.items()}
 
 
 @dataclass(frozen=True)
@@ -97,10 +99,12 @@ class Coupling:
     The contacts present at the start (overlaps as placed, a script's read_restart of a
     settled bed) are not collisions: open and enduring.
     ``resume``: a checkpoint's state (pyhost.checkpoint) to continue from, its logs appended to.
+    ``driven`` [s]: the coupled time of a CFD-DEM script's last run (its case's last coupling step).
     """
 
     def __init__(self, scene, dem: Dem, out: Path, *, type_material, known: Known, walls, fluid=None,
-                 end: float | None = None, progress_every: float = 5.0, resume: dict | None = None):
+                 end: float | None = None, progress_every: float = 5.0, resume: dict | None = None,
+                 driven: float | None = None):
         self.scene, self.dem, self.out, self.fluid = scene, dem, Path(out), fluid
         self.effects = scene.effects_summary()
         self.materials = script_dem_contacts(scene, dem) if scene.scripted else list(scene.materials.values())
@@ -124,7 +128,6 @@ class Coupling:
             self.balance.begin(dem.atoms(True))
         self.fluid_exchange = FluidExchange(self, fluid, logs) if fluid is not None else None
         self.frames = Frames(self, [self.fluid_exchange] if fluid is not None else [], logs)
-        self.effect_list = [e for e in (self.balance, self.collisions, self.fluid_exchange, self.frames) if e is not None]
         self.progress = Progress(end or math.inf, progress_every)
         events = self.collisions is not None
         self.every = dict(harvest=(scene.time.sample_every if self.collisions.restitution else HARVEST_EVERY)
@@ -133,6 +136,9 @@ class Coupling:
                           couple=scene.time.couple_every if fluid is not None else 0,
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
         self.every["frame"] = self.frame_every()
+        self.case_commands = case_commands(self, driven)    # a CFDEM case's: after the DEM's steps, before the fluid's
+        self.effect_list = [e for e in (self.balance, self.collisions, self.case_commands, self.fluid_exchange,
+                                        self.frames) if e is not None]
         if events:                           # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
         self.command, self.run_left = -1, 0  # the script's run under way (its index) and its steps to go
@@ -395,7 +401,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 elif k == replayed:         # the replayed commands since the host's fixes: set up, then
                     dem.run(0)              # the checkpoint's forces go back (Coupling's restore)
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
-                                    progress_every=progress_every, **particles)
+                                    progress_every=progress_every, driven=driven, **particles)
                 if scene.scripted:           # a restart replays them: checked unchanged
                     coupling.inputs = tuple(sorted({c.file for c in commands if c.file != "(host)"}))
                 coupling.extend = extend

@@ -318,6 +318,7 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
     why = cfdem_unsupported(folder)
     if why:
         raise SceneError(f"{file}: fluid.case: {why}")
+    _case_commands(folder, file)
     where = folder / "constant" / "couplingProperties"
     tables = {"effects": effects, "fluid": fluid, "time": time}
     taken = {"effects": {}, "fluid": {}, "time": {}}
@@ -348,6 +349,22 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
                                  "script's, or make them agree")
             taken["time"]["couple_every"] = number
     return tuple(dataclasses.replace(tables[k], **taken[k]) for k in ("effects", "fluid", "time"))
+
+
+def _case_commands(folder: Path, file: str) -> None:
+    """A CFDEM case's liggghtsCommands checked before any engine starts: every model one the
+    host runs (pyhost.effects.case_commands), and fluid write times it can follow if one asks
+    for them."""
+    from foamlib import FoamFile
+
+    from pyhost.engines.cfdem_commands import CaseCommandsError, read_commands, write_times
+
+    try:
+        commands = read_commands(folder, 1)
+        if any(c.when == "write" for c in commands):
+            write_times(FoamFile(folder / "system" / "controlDict").as_dict(), 0.0, 0.0, 1.0)
+    except (CaseCommandsError, KeyError, TypeError, ValueError) as exc:
+        raise SceneError(f"{file}: fluid.case: {exc}") from None
 
 
 def _script_couple_every(script: Path) -> tuple[int, str] | None:

@@ -171,7 +171,8 @@ class Fluid:
                                      "before any engine: each mesh patch has its entry in 0/U and 0/p, "
                                      "decomposeParDict has fluid.ranks subdomains, the mesh files read "
                                      "(docs/exit-codes.md). Copied to OUT/fluid without run outputs, time "
-                                     "folders other than 0 and processor folders")
+                                     "folders other than 0 and the controlDict's start, and processor folders; "
+                                     "a CFDEM case's constant/liggghtsCommands runs as in CFDEM")
     density: float = spec(">0", 1.2, "[kg/m^3]")
     viscosity: float = spec(">0", 1.8e-5, "dynamic viscosity [Pa s]")
     inlet_velocity: float = spec(">=0", 0.0, "superficial velocity at the inlet (fluid z lo) [m/s]")

@@ -5,6 +5,8 @@ the walls, no [materials].dem table (the script sets the DEM values). One sphere
 at the Di Felice terminal speed."""
 import json
 import math
+import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -272,3 +274,115 @@ def test_the_script_is_the_one_the_coupling_names(tmp_path):
     with pytest.raises(SceneError, match=r"dem.script: not given, and .*couplingProperties twoWayMPIProps "
                                          r"liggghtsPath names .*in.liggghts_gone, which does not exist"):
         load_scene(toml)
+
+
+LIGGGHTS_COMMANDS = """FoamFile { version 2.0; format ascii; class dictionary; object liggghtsCommands; }
+
+liggghtsCommandModels ( runLiggghts execute writeLiggghts execute );
+
+executeProps1 { command ( set group all property/atom Temp number ); scalars ( 350 ); runFirst on; }
+
+writeLiggghtsProps { path "../DEM/restarts"; writeName "r"; overwrite off; writeLastOnly off; writeEvery 2; }
+
+executeProps3
+{
+    command ( set group all noBlanks property slash atom blanks Temp number );
+    scalars ( 400 );
+    runFirst off; runLast off; runEveryCouplingStep off; runEveryWriteStep off;
+    startTime 0.0055; endTime 0.0085; timeInterval 1;
+}
+"""
+
+
+def test_the_cases_liggghtsCommands_run_where_cfdem_runs_them(tmp_path):
+    """CFDEM runs a case's constant/liggghtsCommands after the DEM steps of a coupling step
+    (packedBedTemp holds its bed at 600 K so; the host had left them out, exit 0). Here, over
+    10 coupling steps of 1 ms: Temp set to 350 K at the first (runFirst), to 400 K at steps 5 to
+    8 (startTime 0.0055, endTime 0.0085, timeInterval 1: CFDEM floors both to coupling steps),
+    and a LIGGGHTS restart at every second of the fluid's writes (every 2 ms: 2, 6 and 10 ms,
+    time-stamped as CFDEM's ``%f``). The frames see the sets at those times, the energy balance
+    counts them as set by the script (m c 100 K, to 1e-12) and closes to 1e-12."""
+    cfd = cfdem_case(tmp_path, end=0.01, dem="temperature = 300.0")
+    toml = cfd / "case.toml"
+    toml.write_text(toml.read_text().replace("[effects]\nfluid = true\n", '[effects]\nfluid = true\ncontact_heat = "A"\n'))
+    FoamFile(cfd / "system" / "controlDict").update({"writeControl": "adjustableRunTime", "writeInterval": 0.002})
+    (cfd / "constant" / "liggghtsCommands").write_text(LIGGGHTS_COMMANDS)
+    r = run(cfd)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "fluid time 0.001 s: " in r.stdout and "'set group all property/atom Temp 350.000000' (the case's liggghtsCommands" in r.stdout
+    out = cfd / "output"
+    rows = np.genfromtxt(out / "history.csv", delimiter=",", names=True)
+    T = dict(zip(np.round(rows["time"], 6), rows["T_mean"]))
+    assert T == {0.0: 300.0, 0.001: 350.0, 0.002: 350.0, 0.003: 350.0, 0.004: 350.0, 0.005: 400.0, 0.006: 400.0,
+                 0.007: 400.0, 0.008: 400.0, 0.009: 400.0, 0.01: 400.0}
+    s = json.loads((out / "summary.json").read_text())
+    mc = RHO_P * math.pi * D**3 / 6 * 840.0
+    assert s["energy_set_by_script"] == pytest.approx(mc * 100.0, rel=1e-12)
+    assert abs(s["energy_balance_error"]) <= 1e-12
+    assert s["case_commands_run"] == 1 + 4 + 3
+    assert sorted(p.name for p in (cfd.parent / "DEM" / "restarts").iterdir()) == \
+        ["r_0.002000", "r_0.006000", "r_0.010000"]
+
+
+def test_a_liggghtsCommands_model_the_host_does_not_run_is_refused(tmp_path):
+    """A model the host would leave out (setDEMGravity here) is refused before any engine
+    starts, naming the file and the model: the run would not be the case's."""
+    cfd = cfdem_case(tmp_path)
+    (cfd / "constant" / "liggghtsCommands").write_text(
+        LIGGGHTS_COMMANDS.split("liggghtsCommandModels")[0] + "liggghtsCommandModels ( runLiggghts setDEMGravity );\n")
+    r = run(cfd)
+    assert r.returncode == 2, r.stdout[-2000:] + r.stderr[-2000:]
+    assert "constant/liggghtsCommands: liggghtsCommandModels: setDEMGravity: the host runs" in r.stderr
+    assert not (cfd / "output" / "fluid").exists()
+
+
+def restart_script() -> str:
+    """The second stage's script: the first's, with the sphere read from the first stage's
+    LIGGGHTS restart (CFDEM's writeLiggghts) in place of the box and the atom, printing into
+    velocity2.txt, ending in one run 0."""
+    text = SCRIPT.format(d=D, rho_p=RHO_P)
+    head, tail = text.split("region ", 1)
+    tail = tail.split("neighbor", 1)[1]
+    text = head + "read_restart    ../DEM/stage1.restart\nneighbor" + tail
+    text = re.sub(r"create_atoms.*\nset .*\n", "", text).replace("velocity.txt", "velocity2.txt")
+    return text.replace("run     0\nrun     0 upto\n", "run     0\n")
+
+
+def test_a_second_stage_goes_on_from_the_first_stages_fluid_and_dem(tmp_path):
+    """CFDEM's restart in stages (ErgunTestMPI_restart): the first stage writes a LIGGGHTS
+    restart at the fluid's last write (writeLiggghts, writeLastOnly) and the fluid its fields
+    (every 5 ms; the host into OUT/fluid); the second starts at 5 ms (controlDict startTime)
+    with a script reading that restart. It is refused (exit 2, before any engine) until the
+    fluid's 0.005 folder is in the case, naming the copy to make; then the solver's first step
+    is at 6 ms and the falling sphere's speed at 10 ms is the one run's to 1e-4. Measured
+    2.7e-5: a LIGGGHTS restart sets its forces up anew, so the first half step after it kicks
+    the sphere with the fluid force of the 5 ms exchange where the one run's still had the
+    4 ms one's: dt/2 times their difference over the mass, 5e-6 s x 0.53 m/s^2 = 2.7e-6 m/s
+    at 6 ms, the difference seen then and after (as in CFDEM's own restarts)."""
+    cfd = cfdem_case(tmp_path / "one", end=0.01)
+    FoamFile(cfd / "system" / "controlDict").update({"writeControl": "adjustableRunTime", "writeInterval": 0.005})
+    whole = run(cfd)
+    assert whole.returncode == 0, whole.stdout[-3000:] + whole.stderr[-3000:]
+    cfd = cfdem_case(tmp_path / "two", end=0.005)
+    FoamFile(cfd / "system" / "controlDict").update({"writeControl": "adjustableRunTime", "writeInterval": 0.005})
+    (cfd / "constant" / "liggghtsCommands").write_text(
+        LIGGGHTS_COMMANDS.split("liggghtsCommandModels")[0] + "liggghtsCommandModels ( runLiggghts writeLiggghts );\n"
+        'writeLiggghtsProps { writeName "stage1.restart"; overwrite on; writeLastOnly on; }\n')
+    first = run(cfd)
+    assert first.returncode == 0, first.stdout[-3000:] + first.stderr[-3000:]
+    assert (cfd.parent / "DEM" / "stage1.restart").is_file() and (cfd / "output" / "fluid" / "0.005" / "U").is_file()
+    FoamFile(cfd / "system" / "controlDict").update({"startTime": 0.005, "endTime": 0.01})
+    (cfd.parent / "DEM" / "in.liggghts_run").write_text(restart_script())
+    refused = run(cfd, "--overwrite")
+    assert refused.returncode == 2, refused.stdout[-2000:] + refused.stderr[-2000:]
+    assert f"a run of the host wrote it in {cfd / 'output' / 'fluid' / '0.005'}: copy it into the case" in refused.stderr
+    shutil.copytree(cfd / "output" / "fluid" / "0.005", cfd / "0.005")
+    second = run(cfd, "--overwrite")
+    assert second.returncode == 0, second.stdout[-3000:] + second.stderr[-3000:]
+    log = (cfd / "output" / "fluid" / "log.collheatFoam").read_text()
+    assert next(line for line in log.splitlines() if line.startswith("Time = ")) == "Time = 0.006"
+    t, vz = np.loadtxt(cfd.parent / "DEM" / "post" / "velocity2.txt", comments="#", ndmin=2).T
+    t1, vz1 = velocities(tmp_path / "one" / "CFD").T
+    print(f"speed at 10 ms: second stage {vz[-1]:.9g}, one run {vz1[-1]:.9g} m/s")
+    assert t[-1] == pytest.approx(0.01) and t1[-1] == pytest.approx(0.01)
+    assert vz[-1] == pytest.approx(vz1[-1], rel=1e-4)

@@ -1,0 +1,97 @@
+"""A CFDEM case's own LIGGGHTS commands between coupling steps (its constant/liggghtsCommands,
+``pyhost.engines.cfdem_commands``): each run where CFDEM runs it, after the coupling step's
+DEM steps and before the fluid gets the particles, as CFDEM's coupling does. CFDEM's
+packedBedTemp holds its bed at 600 K this way (``set region total property/atom Temp 600``
+at every coupling step); its ErgunTestMPI and settlingTestMPI write LIGGGHTS restarts at the
+fluid's write times. What a command changes of the particles' temperatures is the energy
+balance's ``energy_set_by_script``. Present when the case's file has such commands.
+Its total: ``case_commands_run``, the commands run. SI units."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from foamlib import FoamFile
+
+from pyhost.effects import Effect, by_id
+from pyhost.engines.cfdem_commands import SMALL, read_commands, write_times
+from pyhost.engines.fluid_case import start_time
+from pyhost.script import Command
+
+
+def case_commands(loop, driven: float | None):
+    """The effect for the loop's scene, or None: not a CFDEM case, or no command besides the
+    coupled run in its liggghtsCommands."""
+    fluid = loop.scene.fluid
+    if fluid is None or not fluid.case or loop.fluid is None:
+        return None
+    case = loop.scene.folder / fluid.case
+    commands = read_commands(case, loop.every["couple"])
+    if not commands:
+        return None
+    control = FoamFile(case / "system" / "controlDict").as_dict()
+    start = start_time(case)[0]
+    if driven is None:
+        driven = float(control["endTime"]) - start
+    return CaseCommands(loop, commands, control, start, driven)
+
+
+class CaseCommands(Effect):
+    """``commands``: the case's (``read_commands``); ``control``: the fluid case's controlDict
+    (its write times); ``start`` [s]: the time the fluid starts from; ``driven`` [s]: the
+    coupled time the case runs (its last coupling step)."""
+
+    TOTALS = dict(case_commands_run=0)
+
+    def __init__(self, loop, commands, control: dict, start: float, driven: float):
+        super().__init__(loop)
+        self.commands = commands
+        self.control = control
+        self.start_time = start
+        self.interval = loop.every["couple"] * loop.dem.dt
+        self.last = math.floor((driven + SMALL) / loop.dem.dt / loop.every["couple"])    # CFDEM's lastCouplingStep
+        self.tried = set()             # commands tried once (LIGGGHTS ends the process on a refusal)
+
+    def couple(self) -> None:
+        loop = self.loop
+        k = (loop.dem.step - loop.t0_step) // loop.every["couple"]    # CFDEM's coupling step, from 1
+        t0, t1 = self.start_time + (k - 1) * self.interval, self.start_time + k * self.interval
+        wrote = write_times(self.control, self.start_time, t0, t1) > 0 if any(
+            c.when == "write" for c in self.commands) else False
+        writes = write_times(self.control, self.start_time, self.start_time, t1) if wrote else 0
+        due = [c for c in self.commands
+               if c.due(k, self.last, writes, wrote, self.start_time, loop.dem.dt, loop.every["couple"])]
+        if not due:
+            return
+        before = self.temperatures()
+        for c in due:
+            cmd = Command(c.command(t1), c.file, c.line)
+            if c.text in self.tried:
+                loop.dem.command(cmd)
+            else:                          # the first time: tried in a copy first, its folders made
+                loop.dem.commands([cmd])
+                self.tried.add(c.text)
+                print(f"fluid time {t1:g} s: {c.where}: '{cmd.text}' (the case's liggghtsCommands, as CFDEM runs them; "
+                      "said at the first run of each)")
+        loop.totals["case_commands_run"] += len(due)
+        if before is not None:
+            self.count_set(before)
+
+    def temperatures(self):
+        """(ids, T, m c) of the particles now, copied; None without particle temperatures."""
+        loop = self.loop
+        if loop.balance is None:
+            return None
+        atoms = loop.dem.atoms(True)
+        return atoms.id.copy(), atoms.T.copy(), atoms.mass * loop.capacity[loop.materials_of(atoms.type)]
+
+    def count_set(self, before) -> None:
+        """What the commands changed of the particles' temperatures (those there before and
+        after) [J] goes to the energy balance as set by the script, at their heat capacities
+        before (a change of mass is the balance's own term)."""
+        ids, T, C = before
+        atoms = self.loop.dem.atoms(True)
+        T_after = by_id(atoms.id, atoms.T, ids, missing=np.nan)
+        kept = ~np.isnan(T_after)
+        self.loop.totals["energy_set_by_script"] += float(np.sum(C[kept] * (T_after[kept] - T[kept])))
+        self.loop.track_particles(atoms)
