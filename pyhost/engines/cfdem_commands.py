@@ -191,6 +191,9 @@ def read_commands(case: str | Path, couple_every: int) -> list[CaseCommand]:
         except StopIteration:
             raise CaseCommandsError(f"{where}: its command asks for more 'number' or 'label' words than "
                                     "scalars ( ... ) or labels ( ... ) give") from None
+        if text.split()[:1] in (["run"], ["rerun"]):
+            raise CaseCommandsError(f"{where}: '{text.strip()}': steps run outside the coupling, which the host "
+                                    "does not follow (its time, contacts and heat); give them to the script")
         when, times = _when(props, where)
         found.append(CaseCommand(text.rstrip(), stamp=stamp, when=when, file=str(path), line=line, times=times))
     return found

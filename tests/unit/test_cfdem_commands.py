@@ -85,9 +85,11 @@ def test_compose_numbers_labels_and_the_coupling_interval():
      "runFirst on: CFDEM runs the DEM at the first coupling step only"),
     ("liggghtsCommandModels ( runLiggghts writeLiggghts );\nwriteLiggghtsProps { writeLastOnly on; }",
      "overwrite: CFDEM needs on or off here"),
-    ("liggghtsCommandModels ( runLiggghts execute );\nexecuteProps1 { command ( run number ); runFirst on; }",
+    ("liggghtsCommandModels ( runLiggghts execute );\nexecuteProps1 { command ( set number ); runFirst on; }",
      "asks for more 'number' or 'label' words than"),
-    ("liggghtsCommandModels ( runLiggghts execute );\nexecuteProps1 { command ( run 1 ); runFirst off; runLast off;"
+    ("liggghtsCommandModels ( runLiggghts execute );\nexecuteProps1 { command ( run 100 ); runFirst on; }",
+     "'run 100': steps run outside the coupling"),
+    ("liggghtsCommandModels ( runLiggghts execute );\nexecuteProps1 { command ( print hi ); runFirst off; runLast off;"
      " runEveryCouplingStep off; runEveryWriteStep off; }", "needs startTime, endTime and timeInterval"),
 ])
 def test_what_cfdem_or_the_host_would_not_run_is_refused_naming_it(tmp_path, text, message):
