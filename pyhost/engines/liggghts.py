@@ -10,7 +10,9 @@ array of a ``fix external pf/array`` for per-atom forces set from Python.
 LIGGGHTS ends its process on any error (``exit(1)``). So every command, input file and the
 first run after a change is tried first in a forked copy of this process: when the copy
 dies, :class:`LiggghtsError` carries LIGGGHTS' own ``ERROR`` line and this process goes on
-unharmed. Later run chunks are not tried (a fork costs milliseconds, a chunk microseconds):
+unharmed. A command run before without error is not tried again, nor the run after only such
+repeats (a CFDEM case's ``set`` at every coupling step: two forks a step otherwise). Later run
+chunks are not tried (a fork costs milliseconds, a chunk microseconds):
 the helper turns LIGGGHTS' errors into a return with the message (``collheat_command``), so
 a chunk that fails ("Lost atoms", on any rank together) raises :class:`LiggghtsFailed` and
 the caller can still read the atoms and write its summary; the instance then runs nothing
@@ -180,7 +182,9 @@ class Liggghts:
         argv = (_cp * len(args))(*args)
         self.ptr = _vp()
         self.failed: str | None = None   # LIGGGHTS' error that left this instance mid-command
-        self._changed = True  # a command since the last run: try the next run first
+        self._changed = True  # a command since the last run: the next run sets up anew
+        self._new = True      # ... one not run before: that set-up is tried first
+        self._known = set()   # commands run without error: a repeat is not tried again
         self._ahead: list[str] = []     # the next commands, tried together already (try_ahead)
         if self.comm is not None:
             from mpi4py import MPI
@@ -236,10 +240,15 @@ class Liggghts:
             raise LiggghtsError("'include' does nothing through the C API: use Liggghts.file()")
         if self._ahead and self._ahead[0] == line:
             self._ahead.pop(0)          # passed in the copy that tried it with those before it
+            self._new = True
+        elif line in self._known:       # run before without error (a CFDEM case's command at every
+            pass                        # coupling step): not tried again; an error returns (the helper)
         else:
             self._ahead = []
             self._tried(lambda: self._call(line), line)
+            self._new = True
         self._execute(line, LiggghtsError)
+        self._known.add(line)
         self._changed = True
 
     def try_ahead(self, lines: list[str]) -> None:
@@ -285,7 +294,7 @@ class Liggghts:
         self._ahead = []
         self._tried(lambda: self._call(str(path), is_file=True), f"file {path}")
         self._execute(str(path), LiggghtsError, is_file=True)
-        self._changed = True
+        self._changed = self._new = True
 
     def keep_set_up(self) -> None:
         """The next run starts without a set-up, whatever came since the last one (the caller
@@ -300,12 +309,12 @@ class Liggghts:
             raise ValueError(f"steps must be >= 0, got {steps}")
         self._ahead = []
         line = f"run {steps} post no" if self._changed else f"run {steps} pre no post no"
-        if self._changed:       # the set-up is tried (bad input); what fails while stepping returns
-            self._tried(lambda: self._call("run 0 post no"), line)
-        else:                   # mesh walls keep the bins of their triangles (plugins/liggghts/run_chunks.cpp)
-            self.helper.collheat_keep_mesh_bins(self.ptr)
+        if self._changed and self._new:     # the set-up is tried (bad input), unless only commands run
+            self._tried(lambda: self._call("run 0 post no"), line)     # before came since the last run;
+        elif not self._changed:             # what fails while stepping returns. Mesh walls keep the bins
+            self.helper.collheat_keep_mesh_bins(self.ptr)   # of their triangles (plugins/liggghts/run_chunks.cpp)
         self._execute(line, LiggghtsFailed, what="during the run, at step {step}")
-        self._changed = False
+        self._changed = self._new = False
 
     def _call(self, line: str, is_file: bool = False) -> int:
         """One command (or input file) through the helper: 0, or 1 when LIGGGHTS reported

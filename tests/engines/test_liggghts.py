@@ -184,6 +184,37 @@ def test_commands_tried_together_fork_once_and_a_bad_one_still_reports_its_own_e
         assert lg.step == 10
 
 
+def test_a_command_run_before_is_not_tried_again_and_a_failing_repeat_still_returns(tmp_path, monkeypatch):
+    """A command run before without error (a CFDEM case's 'set ... Temp' at every coupling
+    step) runs without a forked trial, and so does the set-up of the next run when only such
+    repeats came since the last: 2 forks for the first round, 0 for each later one (before: 2
+    each). A repeat that fails now (an unfix of a fix gone) raises LIGGGHTS' own message through
+    the helper, as a chunk that fails: the process survives, its atoms stay readable (the run's
+    summary), and the instance runs nothing more."""
+    import os
+    forks = []
+    real_fork = os.fork
+    monkeypatch.setattr(os, "fork", lambda: forks.append(1) or real_fork())
+    with two_spheres(tmp_path) as lg:
+        lg.run(1)
+        counts = []
+        for _ in range(3):
+            forks.clear()
+            lg.command("set group all vx 0.5")
+            lg.run(5)
+            counts.append(len(forks))
+        assert counts == [2, 0, 0] and lg.step == 16
+        assert np.all(lg.atom("v")[:, 0] == 0.5)           # the repeat ran: each round starts at 0.5 m/s
+        lg.command("fix g all gravity 9.81 vector 0 0 -1")
+        lg.command("unfix g")
+        forks.clear()
+        with pytest.raises(LiggghtsError, match="Could not find fix ID to delete"):
+            lg.command("unfix g")                           # a known line failing now: no fork, the message
+        assert forks == [] and lg.atom("x").shape == (2, 3)
+        with pytest.raises(LiggghtsError, match="runs nothing more"):
+            lg.run(1)                                       # (as after a chunk that failed)
+
+
 def test_a_crash_in_the_trial_copy_is_reported_as_a_crash(tmp_path):
     """A trial copy that dies of a signal (a fault, no ERROR line) is said to have crashed,
     naming the signal, where it used to be "LIGGGHTS refused ...: no message". The instance
