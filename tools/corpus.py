@@ -293,6 +293,13 @@ def copy_file(source: str, target: str):
     return (f"copy {source} to {target} (the tutorial's Allrun.sh does)", apply)
 
 
+def stage_files(suffix: str) -> list:
+    """ErgunTestMPI_restart's files of one stage (``_run``, ``_restart``) copied in, as its
+    Allrun.sh does before each."""
+    return [copy_file(f"CFD/{name}{suffix}", f"CFD/{name}") for name in
+            ("system/controlDict", "constant/couplingProperties", "constant/liggghtsCommands")]
+
+
 def ergun_restart_checks(w: Path, out: Path) -> list[Check]:
     """ErgunTestMPI_restart, run to 0.05 s and extended by 0.05 s (--restart --extend): the
     coupled steps of both stages (its script's closing 'run 1', then 5000 and 5000), and the
@@ -417,21 +424,14 @@ TUTORIALS = [
              native_first=("DEM", "in.liggghts_init"), ranks=4, checks=ergun_checks),
     Tutorial("ErgunTestMPI_restart", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI_restart", "CFD",
              cfdem_scene(2000.0) + "\n[output]\ncheckpoint = 0.01\npictures = false\n",
-             changes=[copy_file("CFD/system/controlDict_run", "CFD/system/controlDict"),
-                      copy_file("CFD/constant/couplingProperties_run", "CFD/constant/couplingProperties"),
-                      copy_file("CFD/constant/liggghtsCommands_run", "CFD/constant/liggghtsCommands")],
+             changes=stage_files("_run"),
              native_first=("DEM", "in.liggghts_init"), then=("--restart", "--extend", "0.05"),
              checks=ergun_restart_checks),
     Tutorial("ErgunTestMPI_restart_stages", "cfdem", "tutorials/cfdemSolverPiso/ErgunTestMPI_restart", "CFD",
              cfdem_scene(2000.0) + "\n[output]\npictures = false\n",    # both stages as its Allrun.sh
-             changes=[copy_file("CFD/system/controlDict_run", "CFD/system/controlDict"),
-                      copy_file("CFD/constant/couplingProperties_run", "CFD/constant/couplingProperties"),
-                      copy_file("CFD/constant/liggghtsCommands_run", "CFD/constant/liggghtsCommands")],
+             changes=stage_files("_run"),
              native_first=("DEM", "in.liggghts_init"), then=("--overwrite",),
-             between=[copy_file("CFD/system/controlDict_restart", "CFD/system/controlDict"),
-                      copy_file("CFD/constant/couplingProperties_restart", "CFD/constant/couplingProperties"),
-                      copy_file("CFD/constant/liggghtsCommands_restart", "CFD/constant/liggghtsCommands"),
-                      copy_tree("host-output/fluid/0.05", "CFD/0.05")],
+             between=stage_files("_restart") + [copy_tree("host-output/fluid/0.05", "CFD/0.05")],
              checks=ergun_stages_checks),
     Tutorial("periodicChannel", "cfdem", "tutorials/cfdemSolverPiso/periodicChannel", "CFD",
              cfdem_scene(2000.0), native_first=("DEM", "in.liggghts_init"), checks=periodic_checks),

@@ -50,7 +50,7 @@ class CaseCommands(Effect):
         self.start_time = start
         self.interval = loop.every["couple"] * loop.dem.dt
         self.last = math.floor((driven + SMALL) / loop.dem.dt / loop.every["couple"])    # CFDEM's lastCouplingStep
-        self.tried = set()             # commands tried once (LIGGGHTS ends the process on a refusal)
+        self.tried = set()             # commands run once (the first time: its folders made, it is said)
 
     def couple(self) -> None:
         loop = self.loop
@@ -68,7 +68,7 @@ class CaseCommands(Effect):
             cmd = Command(c.command(t1), c.file, c.line)
             if c.text in self.tried:
                 loop.dem.command(cmd)
-            else:                          # the first time: tried in a copy first, its folders made
+            else:                          # the first time: its folders made, tried in a copy first
                 loop.dem.commands([cmd])
                 self.tried.add(c.text)
                 print(f"fluid time {t1:g} s: {c.where}: '{cmd.text}' (the case's liggghtsCommands, as CFDEM runs them; "

@@ -43,8 +43,8 @@ class CaseCommand:
     """One command of a liggghtsCommands: ``text`` (the fluid's time appended at each run when
     ``stamp``), when it runs (``when``: "first", "last", "coupling", "write" or "interval";
     "interval" with ``times`` = (startTime, endTime, timeInterval), the last in coupling steps;
-    "write" every ``write_every``-th write time) and where it is written (``file``, ``line``: its
-Props dictionary's, or the model's name in the list's)."""
+    "write" every ``write_every``-th write time) and where it is written (``file``, ``line``:
+    its Props dictionary's, or the model's name in the list's)."""
     text: str
     stamp: bool
     when: str

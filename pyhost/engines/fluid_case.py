@@ -307,7 +307,7 @@ def start_time(case: str | Path) -> tuple[float, str | None]:
     whose first stage the host ran, writing its times into its own output)."""
     case = Path(case)
     control = FoamFile(case / "system" / "controlDict")
-    times = sorted((float(p.name), p.name) for p in case.iterdir() if p.is_dir() and _time_name(p.name))
+    times = sorted((float(p.name), p.name) for p in case.iterdir() if p.is_dir() and is_time_name(p.name))
     how = str(control.get("startFrom", "startTime"))
     if how == "latestTime" or how == "firstTime":
         return times[-1 if how == "latestTime" else 0] if times else (0.0, None)
@@ -315,7 +315,8 @@ def start_time(case: str | Path) -> tuple[float, str | None]:
     return t, next((name for value, name in times if math.isclose(value, t, rel_tol=1e-9, abs_tol=1e-12)), None)
 
 
-def _time_name(name: str) -> bool:
+def is_time_name(name: str) -> bool:
+    """Whether a folder's name is an OpenFOAM time (a finite number)."""
     try:
         return math.isfinite(float(name))
     except ValueError:

@@ -174,13 +174,13 @@ def check_start(folder: Path, file: str) -> None:
     the fluid's state to go on from. A host run writes its fluid's times into its output
     (OUT/fluid), not into the case: where an output folder in the case has that time, the
     message says what to copy (output folders in the case and beside it)."""
-    from pyhost.engines.fluid_case import start_time
+    from pyhost.engines.fluid_case import is_time_name, start_time
 
     t, name = start_time(folder)
     control = folder / "system" / "controlDict"
     if name is None and t != 0.0:
         found = sorted(p for where in (folder, folder.parent) for p in where.glob("*/fluid/*")
-                       if (p.parent.parent / "scene.json").is_file() and re.fullmatch(r"[0-9.eE+-]+", p.name)
+                       if (p.parent.parent / "scene.json").is_file() and is_time_name(p.name)
                        and math.isclose(float(p.name), t, rel_tol=1e-9))
         hint = (f": a run of the host wrote it in {found[-1]}: copy it into the case "
                 f"(cp -r {found[-1]} {folder}/), then run with --overwrite or another --out" if found else
