@@ -338,11 +338,23 @@ def coupling_script(case: str | Path) -> tuple[Path, str] | None:
     return Path(case) / str(script).strip('"'), f"{path} {exchange}Props liggghtsPath"
 
 
+CFDEM_FORCES_KEPT = ("Archimedes", "gradPForce", "viscForce", "LaEuScalarTemp", "scalarGeneralExchange", "noDrag",
+                     "fieldStore", "fieldTimeAverage", "particleCellVolume", "particleVolume", "volWeightedAverage",
+                     "checkCouplingInterval")
+"""CFDEM's force models (couplingProperties' forceModels, CFDEMcoupling-PUBLIC) besides the drag
+laws that a case may list: the host's own interphase force stands for the pressure, viscous and
+buoyancy ones (docs/fluid-cases.md), the heat transfer ones are read, and the rest only store
+or average fields. Any other (MeiLift, virtualMassForce, a model of another CFDEM edition) is a
+force the host does not have: such a case is refused."""
+
+
 def cfdem_unsupported(case: str | Path) -> str | None:
     """Why the host cannot run a CFDEM case as it is written, or None: particles the mesh
     resolves (cfdemSolverIB: voidFractionModel IB or bigParticle, immersed-boundary force
     models), species transported besides T (the eulerian fields of scalarTransportProperties,
-    scalarGeneralExchangeProps' partSpeciesNames), or a flow that is not solved (solveFlow off)."""
+    scalarGeneralExchangeProps' partSpeciesNames), a flow that is not solved (solveFlow off), a
+    force model the host does not have (``CFDEM_FORCES_KEPT``; drag laws are the scene's
+    fluid.drag), or exchange fields smoothed (a smoothingModel other than off)."""
     coupling = Path(case) / "constant" / "couplingProperties"
     if not coupling.is_file():
         return None
@@ -370,6 +382,15 @@ def cfdem_unsupported(case: str | Path) -> str | None:
     if f.get("solveFlow", True) is False:
         return (f"{coupling} solveFlow off: the case keeps its gas still (CFDEM computes only the fluid fraction and "
                 "the forces); the host always solves the gas flow: remove the entry to have the flow solved")
+    other = [str(m) for m in (f.get("forceModels") or []) if not str(m).endswith("Drag")
+             and str(m) not in CFDEM_FORCES_KEPT]
+    if other:
+        return (f"{coupling} forceModels {' '.join(other)}: a force the host does not have (its interphase force is "
+                f"drag, buoyancy and the pressure gradient: docs/fluid-cases.md); remove {other[0]} to run without it")
+    smoothing = f.get("smoothingModel")
+    if smoothing not in (None, False) and str(smoothing) not in ("off", "noSmoothing"):
+        return (f"{coupling} smoothingModel {smoothing}: CFDEM smooths the exchange fields, the host does not; "
+                "set 'smoothingModel off;' to run without it")
     return None
 
 

@@ -351,6 +351,23 @@ def test_a_cfdem_case_whose_flow_is_not_solved_is_refused(tmp_path):
         load_scene(cfdem_layout(tmp_path, props="solveFlow off;"))
 
 
+@pytest.mark.parametrize("props, extra, message", [
+    ("", "MeiLift", "forceModels MeiLift: a force the host does not have"),
+    ("", "virtualMassForce fieldStore", "forceModels virtualMassForce: a force the host does not have"),
+    ("smoothingModel constDiffSmoothing;", "", "smoothingModel constDiffSmoothing: CFDEM smooths the exchange"),
+])
+def test_a_cfdem_case_with_a_force_or_smoothing_the_host_has_not_is_refused(tmp_path, props, extra, message):
+    """CFDEM's lift and virtual mass forces, or its smoothing of the exchange fields, change the
+    answer, and the host has none of them: refused naming the entry, where the host ran without
+    them and ended with exit 0. The tutorials' own lists (drag, Archimedes, gradPForce,
+    viscForce, fieldStore, the heat models; smoothingModel off) pass."""
+    from pyhost.scene import SceneError, load_scene
+
+    with pytest.raises(SceneError, match=rf"fluid.case: .*couplingProperties {message}"):
+        load_scene(cfdem_layout(tmp_path / "bad", drag="KochHillDrag " + extra, props=props))
+    load_scene(cfdem_layout(tmp_path / "good", drag="KochHillDrag viscForce fieldStore", props="smoothingModel off;"))
+
+
 def test_mean_velocity_forces_run_as_collheatfoams(case):
     """CFDEM's meanSupVelocityForce (its Coeffs sub-dictionary, its own keys) and OpenFOAM's
     meanVelocityForce become collheatMeanVelocityForce in the copy, superficial for CFDEM's;
