@@ -136,7 +136,8 @@ class Coupling:
                           couple=scene.time.couple_every if fluid is not None else 0,
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
         self.every["frame"] = self.frame_every()
-        self.case_commands = case_commands(self, driven)    # a CFDEM case's: after the DEM's steps, before the fluid's
+        self.case_commands = (case_commands(self, driven) if fluid is not None and scene.fluid.case  # a user's case's:
+                              else None)                  # after the DEM's steps, before the fluid's exchange
         self.effect_list = [e for e in (self.balance, self.collisions, self.case_commands, self.fluid_exchange,
                                         self.frames) if e is not None]
         if events:                           # the walls' contacts now are open ones: one that begins at

@@ -20,12 +20,9 @@ from pyhost.script import Command
 
 
 def case_commands(loop, driven: float | None):
-    """The effect for the loop's scene, or None: not a CFDEM case, or no command besides the
-    coupled run in its liggghtsCommands."""
-    fluid = loop.scene.fluid
-    if fluid is None or not fluid.case or loop.fluid is None:
-        return None
-    case = loop.scene.folder / fluid.case
+    """The effect for the loop's scene, a user's fluid case, or None: no command besides the
+    coupled run in its liggghtsCommands (or none: not a CFDEM case)."""
+    case = loop.scene.folder / loop.scene.fluid.case
     commands = read_commands(case, loop.every["couple"])
     if not commands:
         return None
