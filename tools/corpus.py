@@ -446,6 +446,10 @@ TUTORIALS = [
     Tutorial("packedBedTempSTM", "cfdem", "tutorials/cfdemSolverPisoSTM/packedBedTemp", "CFD",   # species C
              cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),
              refused="the case transports species (C, speciesC"),
+    Tutorial("packedBedTempParScale", "cfdem", "tutorials/ParScale/cfdemSolverPisoSTM/packedBedTempParScale", "CFD",
+             cfdem_scene(2500.0, cp=0.1, T=0.0, effects='contact_heat = "A"\n'),    # ParScale's particle model
+             changes=[drop_line("DEM/in.liggghts_init", "processors", "it asks for 2 ranks; plain LIGGGHTS runs on 1")],
+             native_first=("DEM", "in.liggghts_init"), refused='Invalid fix style: "couple/pascal"'),
     Tutorial("twoSpheresGlowinskiMPI", "cfdem", "tutorials/cfdemSolverIB/twoSpheresGlowinskiMPI", "CFD",
              cfdem_scene(1500.0), refused="the case resolves its particles on the mesh"),     # immersed boundary
     Tutorial("voidfractionTest", "cfdem", "tutorials/cfdemSolverPiso/voidfractionTest", "CFD",
