@@ -37,11 +37,11 @@ def _set_aside_writes(folder: Path, restart: Path | None) -> list[Path]:
     wrote there of its own (its controlDict's writeControl) up to the checkpoint's time, moved
     aside to OUT/.fluid-earlier to go back into the new copy (those after it are written again).
     Returns where they are."""
-    from pyhost.engines.openfoam import _is_time
+    from pyhost.engines.fluid_case import is_time_name
 
     if restart is None or not Path(folder).is_dir():
         return []
-    saved = [float(p.name) for p in Path(restart).rglob("*") if p.is_dir() and _is_time(p.name)]
+    saved = [float(p.name) for p in Path(restart).rglob("*") if p.is_dir() and is_time_name(p.name)]
     if not saved:
         return []
     aside = Path(folder).parent / ".fluid-earlier"
@@ -49,7 +49,7 @@ def _set_aside_writes(folder: Path, restart: Path | None) -> list[Path]:
     aside.mkdir()
     moved = []
     for p in sorted(Path(folder).iterdir()):
-        if p.is_dir() and _is_time(p.name) and p.name != "0" and float(p.name) <= saved[0] * (1 + 1e-9):
+        if p.is_dir() and is_time_name(p.name) and p.name != "0" and float(p.name) <= saved[0] * (1 + 1e-9):
             moved.append(Path(shutil.move(str(p), aside / p.name)))
     if not moved:
         aside.rmdir()

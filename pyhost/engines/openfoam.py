@@ -32,7 +32,7 @@ import numpy as np
 from foamlib import FoamFile
 
 from plugins import drag as drag_laws
-from pyhost.engines.fluid_case import start_time
+from pyhost.engines.fluid_case import is_time_name, start_time
 
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
 SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[2] / ".setup" / "bin" / "collheatFoam"))
@@ -276,14 +276,14 @@ class FluidSolver:
         t = self.write()
         folder.mkdir(parents=True)
         for d, old in zip(self._time_folders(), before):
-            new = [p for p in d.iterdir() if p.name not in old and p.is_dir() and _is_time(p.name)]
+            new = [p for p in d.iterdir() if p.name not in old and p.is_dir() and is_time_name(p.name)]
             if len(new) == 1:
                 shutil.move(str(new[0]), folder / d.relative_to(self.case) / new[0].name)
                 continue
             # none new: the case's own writeControl wrote this time at this step (its times count from
             # the start, a restart's too), and the write above wrote it again with 17 digits: copied,
             # the case keeps its own write
-            same = [] if new else [p for p in d.iterdir() if p.is_dir() and _is_time(p.name)
+            same = [] if new else [p for p in d.iterdir() if p.is_dir() and is_time_name(p.name)
                                    and math.isclose(float(p.name), t, rel_tol=1e-6, abs_tol=1e-12)]
             if len(same) != 1:
                 raise FluidError(f"the solver's write at t = {t:g} s left {len(new)} new time folders in {d}"
@@ -296,7 +296,7 @@ class FluidSolver:
     def _start_from(self, folder: Path) -> None:
         """Before the launch: ``folder``'s time (:meth:`save`) into the case as its start time."""
         names = {p.name for d in self._time_folders() for p in (folder / d.relative_to(self.case)).glob("*")
-                 if p.is_dir() and _is_time(p.name)}
+                 if p.is_dir() and is_time_name(p.name)}
         if len(names) != 1:
             raise FluidError(f"{folder}: not a saved fluid state (time folders: {sorted(names) or 'none'})")
         name = names.pop()
@@ -609,14 +609,6 @@ def _widen(fd: int) -> None:
         fcntl.fcntl(fd, fcntl.F_SETPIPE_SZ, min(size, 1 << 20))
     except (OSError, ValueError, AttributeError):
         pass
-
-
-def _is_time(name: str) -> bool:
-    try:
-        float(name)
-    except ValueError:
-        return False
-    return True
 
 
 def _state(pid: int) -> str:
