@@ -294,6 +294,17 @@ executeProps3
 """
 
 
+def commands_case(root: Path) -> Path:
+    """The layout run 10 ms with temperatures (300 K, collision heat A), the fluid writing every
+    2 ms, and LIGGGHTS_COMMANDS; returns CFD/."""
+    cfd = cfdem_case(root, end=0.01, dem="temperature = 300.0")
+    toml = cfd / "case.toml"
+    toml.write_text(toml.read_text().replace("[effects]\nfluid = true\n", '[effects]\nfluid = true\ncontact_heat = "A"\n'))
+    FoamFile(cfd / "system" / "controlDict").update({"writeControl": "adjustableRunTime", "writeInterval": 0.002})
+    (cfd / "constant" / "liggghtsCommands").write_text(LIGGGHTS_COMMANDS)
+    return cfd
+
+
 def test_the_cases_liggghtsCommands_run_where_cfdem_runs_them(tmp_path):
     """CFDEM runs a case's constant/liggghtsCommands after the DEM steps of a coupling step
     (packedBedTemp holds its bed at 600 K so; the host had left them out, exit 0). Here, over
@@ -302,11 +313,7 @@ def test_the_cases_liggghtsCommands_run_where_cfdem_runs_them(tmp_path):
     and a LIGGGHTS restart at every second of the fluid's writes (every 2 ms: 2, 6 and 10 ms,
     time-stamped as CFDEM's ``%f``). The frames see the sets at those times, the energy balance
     counts them as set by the script (m c 100 K, to 1e-12) and closes to 1e-12."""
-    cfd = cfdem_case(tmp_path, end=0.01, dem="temperature = 300.0")
-    toml = cfd / "case.toml"
-    toml.write_text(toml.read_text().replace("[effects]\nfluid = true\n", '[effects]\nfluid = true\ncontact_heat = "A"\n'))
-    FoamFile(cfd / "system" / "controlDict").update({"writeControl": "adjustableRunTime", "writeInterval": 0.002})
-    (cfd / "constant" / "liggghtsCommands").write_text(LIGGGHTS_COMMANDS)
+    cfd = commands_case(tmp_path)
     r = run(cfd)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     assert "fluid time 0.001 s: " in r.stdout and "'set group all property/atom Temp 350.000000' (the case's liggghtsCommands" in r.stdout
@@ -386,3 +393,27 @@ def test_a_second_stage_goes_on_from_the_first_stages_fluid_and_dem(tmp_path):
     print(f"speed at 10 ms: second stage {vz[-1]:.9g}, one run {vz1[-1]:.9g} m/s")
     assert t[-1] == pytest.approx(0.01) and t1[-1] == pytest.approx(0.01)
     assert vz[-1] == pytest.approx(vz1[-1], rel=1e-4)
+
+
+@pytest.mark.skipif(shutil.which("mpirun") is None, reason="no mpirun: tools/setup.sh --engines")
+def test_the_cases_liggghtsCommands_on_two_ranks_as_serially(tmp_path):
+    """The same liggghtsCommands under ``mpirun -np 2`` (LIGGGHTS' domain split, the commands
+    ordered to both ranks): the same Temp history, the same energy set by the script, the same
+    restart files, as the serial run."""
+    import os
+    results = {}
+    for ranks in (1, 2):
+        cfd = commands_case(tmp_path / str(ranks))
+        cmd = [sys.executable, "-m", "pyhost", "run", str(cfd)]
+        r = subprocess.run((["mpirun", "--oversubscribe", "-np", "2"] if ranks == 2 else []) + cmd, capture_output=True,
+                           text=True, cwd=ROOT, timeout=600,
+                           env=dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1"))
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        rows = np.genfromtxt(cfd / "output" / "history.csv", delimiter=",", names=True)
+        s = json.loads((cfd / "output" / "summary.json").read_text())
+        results[ranks] = (list(rows["T_mean"]), s["energy_set_by_script"], s["case_commands_run"],
+                          sorted(p.name for p in (cfd.parent / "DEM" / "restarts").iterdir()))
+    log = (tmp_path / "2" / "CFD" / "output" / "dem" / "log.liggghts").read_text()
+    grid = next(line for line in log.splitlines() if "MPI processor grid" in line).split("MPI")[0].split()
+    assert int(grid[0]) * int(grid[2]) * int(grid[4]) == 2
+    assert results[2] == results[1]
