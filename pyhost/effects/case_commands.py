@@ -47,7 +47,7 @@ class CaseCommands(Effect):
         self.start_time = start
         self.interval = loop.every["couple"] * loop.dem.dt
         self.last = math.floor((driven + SMALL) / loop.dem.dt / loop.every["couple"])    # CFDEM's lastCouplingStep
-        self.tried = set()             # commands run once (the first time: its folders made, it is said)
+        self.said = set()              # commands said at their first run
 
     def couple(self) -> None:
         loop = self.loop
@@ -61,13 +61,11 @@ class CaseCommands(Effect):
         if not due:
             return
         before = self.temperatures()
-        for c in due:
+        for c in due:                      # (its folders made; the bridge tries a command the first time only)
             cmd = Command(c.command(t1), c.file, c.line)
-            if c.text in self.tried:
-                loop.dem.command(cmd)
-            else:                          # the first time: its folders made, tried in a copy first
-                loop.dem.commands([cmd])
-                self.tried.add(c.text)
+            loop.dem.commands([cmd])
+            if c.text not in self.said:
+                self.said.add(c.text)
                 print(f"fluid time {t1:g} s: {c.where}: '{cmd.text}' (the case's liggghtsCommands, as CFDEM runs them; "
                       "said at the first run of each)")
         loop.totals["case_commands_run"] += len(due)
