@@ -90,8 +90,7 @@ def main(argv=None) -> int:
         shutil.rmtree(copy, ignore_errors=True)
         shutil.copytree(args.cfdem / folder, copy)
         (copy / "post").mkdir(exist_ok=True)
-        materials = corpus.MATERIAL.format(density=density, cp=840.0, T=300.0).replace("types = [1]", "types = [1, 2]")
-        (copy / "case.toml").write_text(f'[dem]\nscript = "{script}"\n\n[effects]\ncontact_heat = "A"\n\n' + materials)
+        (copy / "case.toml").write_text(corpus.liggghts_scene(script, density, types="[1, 2]"))
         jobs.append((name, copy, script, [], []))
     for name, (script, variables, options) in OWN.items():
         if not args.only or name in args.only:
