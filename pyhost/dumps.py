@@ -140,35 +140,102 @@ SETUP_COMMANDS = ("units", "dimension", "boundary", "atom_style", "atom_modify",
 resolves them (variables, ${...}): set-up only, no particles, no runs, no files written."""
 
 
-def resolve_setup(lines: list[tuple[int, str]], path: Path) -> tuple[float | None, np.ndarray | None, str | None]:
+SAME_IN_SETUP = frozenset("sqrt exp ln log abs sin cos tan asin acos atan atan2 ceil floor round ternary PI "
+                          "xlo xhi ylo yhi zlo zhi lx ly lz vol".split())
+"""What an equal-style formula may name, besides numbers and other such variables, and mean in
+post's set-up (a box, no particles, no step run) what it means in the run."""
+
+_NUMBER = re.compile(r"(?<![A-Za-z_])(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+_REFERENCE = re.compile(r"\$\{(\w+)\}|\$(\w)|\bv_(\w+)")
+
+
+def _references(text: str) -> set[str]:
+    """The variables a command or formula names: ${name}, $x and v_name."""
+    return {a or b or c for a, b, c in _REFERENCE.findall(text)}
+
+
+def _read_by_post(words: list[str]) -> bool:
+    """Whether post reads this command's values, whose ``$`` variables it then has LIGGGHTS
+    substitute at their place in the set-up: a fix property/global, a primitive wall, a run
+    or reset_timestep, a set of Temp."""
+    return (words[0] in ("run", "reset_timestep")
+            or words[0] == "fix" and len(words) > 3 and (words[3] == "property/global"
+                                                         or words[3] == "wall/gran" and "primitive" in words)
+            or words[0] == "set" and "property/atom" in words and "Temp" in words)
+
+
+def setup_variables(lines: list[tuple[int, str]], given: dict) -> tuple[set[str], dict[str, str]]:
+    """Which variables of a script's ``variable`` commands (and ``given``, the command line's
+    ``-var``) post's set-up gives the run's values: (those names, why each other one cannot:
+    an atom-style, file or python variable, or an equal-style formula naming what needs the
+    particles or the run, such as count(all), step or c_ID). A name defined more than once
+    must be so in each definition."""
+    why, depends = {}, {}
+    for _, text in lines:
+        words = text.split()
+        if words[0] != "variable" or len(words) < 3 or words[2] == "delete":
+            continue
+        name, style, rest = words[1], words[2], " ".join(words[3:])
+        depends.setdefault(name, set())
+        if style in ("index", "string", "universe", "uloop", "loop", "world", "format"):
+            depends[name] |= _references(rest) | ({words[3]} if style == "format" and len(words) > 3 else set())
+        elif style == "equal":
+            formula = _NUMBER.sub(" ", _REFERENCE.sub(" ", rest.strip("\"'")))
+            other = sorted(set(re.findall(r"[A-Za-z_]\w*", formula)) - SAME_IN_SETUP)
+            if other:
+                why.setdefault(name, f"its formula names {', '.join(other)}")
+            depends[name] |= _references(rest)
+        else:
+            why.setdefault(name, f"it is {style}-style")
+    known = set(depends) | set(given)
+    changed = True
+    while changed:                      # what depends on a variable post cannot evaluate cannot either
+        changed = False
+        for name, needs in depends.items():
+            bad = next((n for n in sorted(needs) if n in why or n not in known), None)
+            if bad is not None and name not in why:
+                why[name] = f"it names {bad}" + ("" if bad in known else " (not defined)")
+                changed = True
+    return {n for n in known if n not in why}, why
+
+
+def resolve_setup(lines: list[tuple[int, str]], path: Path, asked: list[tuple[int, str]] = (),
+                  variables: dict | None = None) -> tuple[float | None, np.ndarray | None, dict, str | None]:
     """Time step [s] and box (3, 2) [m] of a script's set-up commands ``lines`` (line
-    number, text) as LIGGGHTS itself evaluates them: the ``liggghts`` program runs them in a
-    scratch folder and prints the values (a process of its own: its VTK and pyvista's do not
-    share one). (None, None, why) when LIGGGHTS refuses one of them."""
+    number, text) as LIGGGHTS itself evaluates them, and the commands ``asked`` with their
+    variables substituted at their place ({line number: text}): the ``liggghts`` program runs
+    the set-up in a scratch folder, with ``variables`` as its ``-var`` options, and prints the
+    values (a process of its own: its VTK and pyvista's do not share one). (None, None, {},
+    why) when LIGGGHTS refuses one of them."""
     import subprocess
     import tempfile
 
     timestep = [t.split(None, 1)[1] for _, t in lines if t.split()[0] == "timestep"]
     boxed = any(t.split()[0] == "create_box" for _, t in lines)
-    body = [t for _, t in lines if t.split()[0] != "timestep"]
+    prints = [(n, f'print "COLLHEAT_LINE {n} {t}"') for n, t in asked]
+    body = [t for _, t in sorted([*lines, *prints], key=lambda nt: nt[0]) if t.split()[0] != "timestep"]
     if timestep:
         body.append(f'print "COLLHEAT_DT {timestep[-1]}"')
     if boxed:
         names = [f"{a}{e}" for a in "xyz" for e in ("lo", "hi")]
         body += [f"variable collheat_{n} equal {n}" for n in names]
         body.append('print "COLLHEAT_BOX ' + " ".join(f"${{collheat_{n}}}" for n in names) + '"')
+    given = [w for name, value in (variables or {}).items() for w in ("-var", name, str(value))]
     with tempfile.TemporaryDirectory(prefix="collheat-setup-") as tmp:
         (Path(tmp) / "in.setup").write_text("\n".join(body) + "\n")
-        r = subprocess.run(["liggghts", "-in", "in.setup", "-screen", "screen.txt", "-log", "none"], cwd=tmp,
-                           capture_output=True, text=True, timeout=120)
-        screen = (Path(tmp) / "screen.txt").read_text(errors="replace") if (Path(tmp) / "screen.txt").exists() else ""
+        # line-buffered: LIGGGHTS' error line would be lost in the buffer at its MPI_Abort
+        r = subprocess.run(["stdbuf", "-oL", "liggghts", "-in", "in.setup", "-log", "none", *given],
+                           cwd=tmp, capture_output=True, text=True, errors="replace", timeout=120)
+    screen = r.stdout
     errors = [ln for ln in screen.splitlines() if ln.startswith("ERROR")]
     if r.returncode or errors:
-        return None, None, f"{path}: {(errors or [r.stdout.strip() or 'no message'])[-1]}"
+        return None, None, {}, f"{path}: {(errors or ['no message, exit ' + str(r.returncode)])[-1]}"
     values = {ln.split()[0]: ln.split()[1:] for ln in screen.splitlines() if ln.startswith("COLLHEAT_")}
     dt = float(values["COLLHEAT_DT"][0]) if "COLLHEAT_DT" in values else None
     box = np.array(values["COLLHEAT_BOX"], float).reshape(3, 2) if "COLLHEAT_BOX" in values else None
-    return dt, box, None
+    substituted = {int(ln.split()[1]): ln.split(None, 2)[2] for ln in screen.splitlines()
+                   if ln.startswith("COLLHEAT_LINE ")}
+    return dt, box, substituted, None
 
 
 def local_compute(path) -> str:
@@ -199,36 +266,77 @@ def _joined(text: str):
         yield first, pending
 
 
-def read_script(path) -> Script:
+def _is_number(words: list[str]) -> bool:
+    try:
+        float(words[0])
+        return True
+    except (IndexError, ValueError):
+        return False
+
+
+def read_script(path, variables: dict | None = None) -> Script:
     """Reads ``timestep``, the local computes and the mesh wall fixes of a LIGGGHTS input, its
     property/globals, wall types, and the steps at which it sets particles' Temp (counted
-    through its plain-number ``run N [upto]`` and ``reset_timestep``) (``&`` continuations and
-    ``#`` comments handled; ``include`` is not followed)."""
+    through its ``run N [upto]`` and ``reset_timestep``) (``&`` continuations and ``#``
+    comments handled; ``include`` is not followed). ``$`` variables in those commands are
+    substituted by LIGGGHTS at their place in the script's set-up (``resolve_setup``), with
+    ``variables`` as LIGGGHTS' command line ``-var`` gives them, where post's set-up gives them
+    the run's values (``setup_variables``); a command whose variables it cannot substitute keeps
+    them, and a warning says why."""
     path = Path(path)
     try:
         text = path.read_text()
     except OSError as exc:
         raise ValueError(f"{path}: cannot read the LIGGGHTS script: {exc.strerror}") from None
-    timestep, computes, walls, warnings = None, {}, [], []
-    setup, heat_gran, primitives, literal = [], [], {}, True
+    commands = [(number, " ".join(line.split("#")[0].split())) for number, line in _joined(text)]
+    commands = [(number, line) for number, line in commands if line]
+    variables = {str(k): str(v) for k, v in (variables or {}).items()}
+    setup = [(number, line) for number, line in commands if line.split()[0] in SETUP_COMMANDS]
+    same, why_not = setup_variables(setup, variables)
+    warnings, asked = [], []
+    for number, line in commands:
+        if "$" not in line or not _read_by_post(line.split()):
+            continue
+        bad = sorted(_references(line) - same)
+        if '"' in line or "$(" in line:
+            bad = bad or ["a quoted text or $(...)"]
+        if bad:
+            reasons = "; ".join(f"{n}: {why_not.get(n, 'not defined (give --var ' + n + ' VALUE)')}" for n in bad)
+            warnings.append(f"{path}: line {number}: post cannot substitute its variables ({reasons})")
+        else:
+            asked.append((number, line))
+    literal = all(_is_number(line.split()[1:2]) for _, line in setup if line.split()[0] == "timestep")
+    substituted, dt, box = {}, None, None
+    if asked or not literal or any(line.split()[0] == "create_box" for _, line in setup):
+        dt, box, substituted, why = resolve_setup(setup, path, asked, variables)
+        if why and asked:               # the set-up alone, as without the substitutions
+            dt, box, substituted, why_setup = resolve_setup(setup, path, (), variables)
+            if not why_setup:
+                warnings.append(f"LIGGGHTS could not substitute the script's variables ({why}): they stay unread")
+            why = why_setup
+        if why:
+            undefined = sorted({n for _, line in setup for n in _references(line)} - same - set(why_not))
+            warnings.append(f"LIGGGHTS could not run the script's set-up ({why}"
+                            + (f"; not defined: {', '.join(undefined)}: give --var NAME VALUE as on LIGGGHTS' "
+                               "command line" if undefined else "")
+                            + "): its time step, box and variables are unknown; give --dt")
+    timestep, computes, walls = None, {}, []
+    heat_gran, primitives = [], {}
     globals_, info = {}, ScriptInfo()      # info: the walls and their atom types, as a run learns them
     step, temperature_sets, ran = 0, [], False    # the step reached (None: unknown, a $variable); any run yet
-    for number, line in _joined(text):
-        words = line.split("#")[0].split()
-        if not words:
-            continue
+    for number, line in commands:
+        line = substituted.get(number, line)
+        words = line.split()
         where = f"{path}: line {number}: "
         try:
-            info.learn(Command(" ".join(words), str(path), number))
+            info.learn(Command(line, str(path), number))
         except (ScriptError, ValueError):
             pass                        # a wall the run would refuse: post places none
-        if words[0] in SETUP_COMMANDS:
-            setup.append((number, " ".join(words)))
         if words[0] == "timestep" and len(words) > 1:
             try:
                 timestep = float(words[1])
             except ValueError:
-                timestep, literal = None, False
+                timestep = dt
         elif words[0] == "fix" and len(words) > 3 and words[3] == "heat/gran":
             heat_gran.append(words[1])
         elif words[0] == "fix" and len(words) > 5 and words[3] == "property/global":
@@ -256,14 +364,6 @@ def read_script(path) -> Script:
         elif (words[0] == "set" and ran and "property/atom" in words[:-2]
               and words[words.index("property/atom") + 1] == "Temp"):     # (before any run: the first frame's)
             temperature_sets.append((step, where.rstrip(": "), " ".join(words)))
-    box = None
-    if not literal or any(t.split()[0] == "create_box" for _, t in setup):
-        dt, box, why = resolve_setup(setup, path)
-        if why:
-            warnings.append(f"LIGGGHTS could not run the script's set-up ({why}): its time step and box are unknown; "
-                            "give --dt")
-        elif not literal:
-            timestep = dt
     wall_types = {fix: info.wall_type(fix) for fix in info.walls if info.wall_type(fix) is not None}
     return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), primitives, globals_,
                   wall_types, tuple(temperature_sets))

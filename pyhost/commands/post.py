@@ -20,6 +20,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="dump local files of compute pair/gran/local and wall/gran/local")
     p.add_argument("--script", type=Path, help="the LIGGGHTS input that wrote the dumps (timestep, computes, "
                                                "mesh wall fixes)")
+    p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
+                   help="a variable the script takes from LIGGGHTS' command line (liggghts -var NAME VALUE), "
+                        "for the script's $NAME in the values post reads")
     p.add_argument("--compute", action="append", default=[], metavar="'ID STYLE KEYWORDS'",
                    help="a contact compute's keywords when there is no script, e.g. 'cp pair/gran/local pos vel id'")
     p.add_argument("--model", choices=(*MODELS, "all"), default="all", help="contact heat model")
@@ -36,8 +39,10 @@ def run(args) -> int:
     from pyhost.dumps import parse_compute, read_script
     from pyhost.post import Post, load_post_scene
 
+    if args.var and not args.script:
+        raise ValueError("--var: give --script, the LIGGGHTS input whose variables they are")
     scene = load_post_scene(args.scene)
-    script = read_script(args.script) if args.script else None
+    script = read_script(args.script, dict(args.var)) if args.script else None
     computes = {c.id: c for c in (parse_compute(text, "--compute: ") for text in args.compute)}
     if args.dt is not None and not args.dt > 0:
         raise ValueError(f"--dt: must be > 0, got {args.dt}")

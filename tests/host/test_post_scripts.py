@@ -130,3 +130,49 @@ def test_temperature_column_of_a_heat_gran_fix_id(tmp_path):
     print(summary["heat_J"])
     assert summary["heat_J"]["A"] > 0
     assert any("fix heat/gran (heattransfer)" in w and "not by heat/gran's conduction" in w for w in summary["warnings"])
+
+
+def test_values_given_as_variables_read_as_their_numbers(tmp_path):
+    """A script whose values post reads are variables, as users write them: the DEM modulus
+    ``${E}`` (an equal-style formula), the floor at ``${zfloor}`` (from LIGGGHTS' command line:
+    ``liggghts -var zfloor 0.0``, post's ``--var zfloor 0.0``), and its runs ``run ${half}`` with
+    a Temp set ``${Tset}`` between them. post on the run's dumps with that script gives what it
+    gives with the same script in plain numbers, to the last digit: the set followed at step
+    3,000 (before the impact at about 4,500: 320 K against the 350 K floor), the same impact and
+    heat. Without the --var, the floor's variable is named in the warnings and the floor left out."""
+    plain = (SCRIPT.replace("run 6000\n", "run 3000\nset group all property/atom Temp 320\nrun 3000\n"))
+    variables = (plain.replace("youngsModulus peratomtype 5e6", "youngsModulus peratomtype ${E}")
+                 .replace("zplane 0.0", "zplane ${zfloor}")
+                 .replace("run 3000\n", "run ${half}\n")
+                 .replace("Temp 320", "Temp ${Tset}")
+                 .replace("variable dt equal 1e-5\n", "variable dt equal 1e-5\nvariable E equal 5*10^6\n"
+                          "variable half equal 6000/2\nvariable Tset index 320\n"))
+    assert variables.count("${half}") == 2 and "${zfloor}" in variables
+    (tmp_path / "post").mkdir()
+    (tmp_path / "in.drop").write_text(plain)
+    (tmp_path / "in.vars").write_text(variables)
+    (tmp_path / "scene.toml").write_text(SCENE)
+    r = subprocess.run(["liggghts", "-in", "in.drop", "-screen", "/dev/null", "-log", "log.drop"], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout[-2000:]
+
+    def run(script, out, *var):
+        r = subprocess.run([sys.executable, "-m", "pyhost", "post", str(tmp_path / "post" / "dump.*"), "--scene",
+                            str(tmp_path / "scene.toml"), "--script", str(tmp_path / script), "--out",
+                            str(tmp_path / out), "--model", "A", *var], capture_output=True, text=True, cwd=ROOT,
+                           timeout=300)
+        assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+        return json.loads((tmp_path / out / "summary.json").read_text())
+
+    numbers = run("in.drop", "plain")
+    given = run("in.vars", "vars", "--var", "zfloor", "0.0")
+    print(numbers["heat_J"], numbers["temperature_sets"], given["warnings"])
+    [done] = given["temperature_sets"]
+    assert done["steps"] == [3000] and done["commands"][0].endswith("set group all property/atom Temp 320")
+    assert numbers["collisions"]["particle_wall"] >= 1
+    assert given["collisions"] == numbers["collisions"] and given["heat_J"] == numbers["heat_J"]
+    assert first_impact(tmp_path, "vars") == first_impact(tmp_path, "plain")
+
+    missing = run("in.vars", "missing")
+    assert any("zfloor: not defined (give --var zfloor VALUE)" in w for w in missing["warnings"])
+    assert missing["collisions"]["particle_wall"] == 0

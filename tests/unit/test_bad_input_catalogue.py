@@ -432,6 +432,8 @@ CLI = {  # id: (arguments, exit code, words)
     "collide R1 zero": (["collide", "--R1", "0"], 2, ["R1"]),
     "collide Y NaN": (["collide", "--Y", "nan"], 2, ["Y"]),
     "pictures of no run": (["pictures", "/nonexistent"], 2, ["history.csv"]),
+    "post --var without its script": (["post", "dump.*", "--scene", "scene.toml", "--var", "n", "5"], 2,
+                                      ["--var", "--script"]),
 }
 
 

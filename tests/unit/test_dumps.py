@@ -6,7 +6,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from pyhost.dumps import Compute, DumpError, DumpReader, parse_compute, read_script
+from pyhost.dumps import Compute, DumpError, DumpReader, parse_compute, read_script, setup_variables
 
 ALL = ("id", "type", "position", "velocity", "radius")
 STEPS = list(range(0, 6001, 500))
@@ -291,3 +291,22 @@ def test_the_steps_of_a_scripts_temperature_sets(tmp_path):
     assert [(step, where.rsplit(": ", 1)[1]) for step, where, _ in sets] == \
         [(100, "line 4"), (500, "line 7"), (None, "line 9"), (7, "line 12")]
     assert sets[0][2] == "set region hot property/atom Temp 800."
+
+
+def test_which_variables_posts_set_up_evaluates_as_the_run_does():
+    """post's set-up runs a script's variable commands with a box and no particles: numbers,
+    the box, math functions and such variables mean there what they mean in the run (after
+    Debian's packing tutorial's growth formula); a formula naming the particles (count(all)),
+    the run (step) or a compute, an atom-style variable, and whatever names one of them or an
+    undefined variable do not, each with the reason; a -var value counts as defined."""
+    lines = list(enumerate([
+        "variable alphastart equal 0.25", "variable growts equal 50000",
+        "variable Rgrowrate equal (0.67/${alphastart})^(40/(3.*${growts}))",
+        "variable top equal zhi-0.5*lz+v_growts*1e-9", "variable n index 10 20", "variable label format n %.3f",
+        "variable nat equal count(all)", "variable t equal step*dt", "variable d atom 2.*c_rad",
+        "variable twice equal 2*${nat}", "variable late equal ${fromcli}+1", "variable gone equal ${nowhere}",
+        "region box block 0 ${top} 0 1 0 1"], start=1))
+    same, why = setup_variables(lines, {"fromcli": "3"})
+    assert same == {"alphastart", "growts", "Rgrowrate", "top", "n", "label", "late", "fromcli"}
+    assert why == {"nat": "its formula names all, count", "t": "its formula names dt, step", "d": "it is atom-style",
+                   "twice": "it names nat", "gone": "it names nowhere (not defined)"}
