@@ -260,17 +260,26 @@ def output_files(cmd: Command) -> list[str]:
     return [w[k] for k in at if k < len(w)]
 
 
+def _keyword(words: list[str], name: str) -> str | None:
+    """The word after keyword ``name`` of a fix command (its 5th word on), or None."""
+    at = [k for k in range(4, len(words) - 1) if words[k] == name]
+    return words[at[-1] + 1] if at else None
+
+
 @dataclass(frozen=True)
 class GranWall:
     """A ``fix ID group wall/gran ...``: a primitive wall (``primitive`` = (kind, numbers),
     kind xplane, yplane, zplane, xcylinder, ycylinder or zcylinder; numbers None where the
-    script gives them as variables) or mesh walls (``meshes``: ids of their fix mesh/surface)."""
+    script gives them as variables) or mesh walls (``meshes``: ids of their fix mesh/surface).
+    ``temperature``: a primitive wall's ``temperature`` as written (a number or a $variable),
+    with which the script's fix heat/gran conducts through its contacts; None: none."""
 
     fix: str
     primitive: tuple | None = None
     meshes: tuple = ()
     type: int | None = None
     moving: bool = False
+    temperature: str | None = None
 
 
 def parse_wall(cmd: Command) -> GranWall | None:
@@ -294,7 +303,7 @@ def parse_wall(cmd: Command) -> GranWall | None:
         except ValueError:
             numbers = None
         return GranWall(w[1], primitive=(kind, numbers), type=wall_type,
-                        moving=any(x in w for x in ("wiggle", "shear", "rotate")))
+                        moving=any(x in w for x in ("wiggle", "shear", "rotate")), temperature=_keyword(w, "temperature"))
     if "meshes" in w:
         k = w.index("meshes")
         n = int(w[w.index("n_meshes") + 1]) if "n_meshes" in w else 1
@@ -308,6 +317,7 @@ class ScriptInfo:
 
     walls: dict = field(default_factory=dict)           # fix id -> GranWall
     mesh_types: dict = field(default_factory=dict)      # fix mesh/surface id -> atom type of the wall
+    mesh_temperatures: dict = field(default_factory=dict)  # fix mesh/surface id -> its 'temperature' as written
     heat_gran: str | None = None                        # id of fix heat/gran
     temp_fix: bool = False                              # a fix property/atom Temp exists
     globals: dict = field(default_factory=dict)         # property/global name -> fix id
@@ -321,6 +331,15 @@ class ScriptInfo:
         if wall is None:
             return None
         return wall.type if wall.primitive is not None else self.mesh_types.get(wall.meshes[mesh])
+
+    def wall_temperatures(self, fix: str) -> list[str]:
+        """The temperatures a wall fix's primitive, or its meshes, have in the script (as
+        written), with which a fix heat/gran conducts through their contacts."""
+        wall = self.walls.get(fix)
+        if wall is None:
+            return []
+        found = [wall.temperature] if wall.primitive is not None else [self.mesh_temperatures.get(m) for m in wall.meshes]
+        return [t for t in found if t is not None]
 
     def _random(self, key: str, defined: bool) -> None:
         if key in self.randoms:
@@ -336,6 +355,8 @@ class ScriptInfo:
                 self.walls[w[1]] = parse_wall(cmd)
             elif style.startswith("mesh/surface") and "type" in w:
                 self.mesh_types[w[1]] = int(w[w.index("type") + 1])
+                if _keyword(w, "temperature") is not None:
+                    self.mesh_temperatures[w[1]] = _keyword(w, "temperature")
             elif style == "heat/gran":
                 self.heat_gran = w[1]
             elif style == "property/atom" and len(w) >= 5 and w[4] == "Temp":

@@ -117,6 +117,20 @@ def test_debian_heat_source_tutorial_closes_its_balance_with_the_sources_heat(tm
     assert abs(summary["energy_balance_error"]) < 1e-12
 
 
+def hot_floor_case(tmp_path: Path, walls: str = "") -> Path:
+    """heatTransfer_1 with its floor at 1000 K for its fix heat/gran ('zplane 0.0 temperature
+    1000.'), the scene's [[walls]] as given, run to 0.52 s by --test."""
+    case = tmp_path / "heatTransfer_1"
+    shutil.copytree(TUTORIAL, case)
+    script = case / "in.heatGran"
+    text = script.read_text()
+    floor = next(line for line in text.splitlines() if line.startswith("fix zwalls1"))
+    script.write_text(text.replace(floor, floor.rstrip() + " temperature 1000."))
+    (case / "case.toml").write_text('[dem]\nscript = "in.heatGran"\n[effects]\ncontact_heat = "A"\n' + STEEL + walls
+                                    + "[time]\ntest_end = 0.52\n[output]\nvtk = false\npictures = false\n")
+    return case
+
+
 @pytest.mark.skipif(not TUTORIAL.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
 def test_heat_gran_wall_with_a_temperature_enters_the_balance(tmp_path):
     """heatTransfer_1 with its floor at 1000 K for heat/gran ('zplane 0.0 temperature 1000.',
@@ -124,21 +138,29 @@ def test_heat_gran_wall_with_a_temperature_enters_the_balance(tmp_path):
     (heat_from_script_walls, the net of heat/gran's flux summed at every step, its pair
     terms cancelling), positive, and the balance closes. Without it the run failed (exit 3)
     with the balance 4080 J off over 0.55 s."""
-    case = tmp_path / "heatTransfer_1"
-    shutil.copytree(TUTORIAL, case)
-    script = case / "in.heatGran"
-    text = script.read_text()
-    floor = next(line for line in text.splitlines() if line.startswith("fix zwalls1"))
-    script.write_text(text.replace(floor, floor.rstrip() + " temperature 1000."))
-    (case / "case.toml").write_text('[dem]\nscript = "in.heatGran"\n[effects]\ncontact_heat = "A"\n' + STEEL
-                                    + "[time]\ntest_end = 0.52\n[output]\nvtk = false\npictures = false\n")
-    r, summary = run(case, "--test")
+    r, summary = run(hot_floor_case(tmp_path), "--test")
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert ("LIGGGHTS wall 'zwalls1' has no [[walls]] entry: adiabatic for collision heat (the script's fix "
+            "heat/gran conducts through its contacts at 1000. K" in r.stdout)
     print(f"heat_from_script_walls {summary['heat_from_script_walls']:.6g} J, "
           f"balance {summary['energy_balance_error']:.3g}")
     assert summary["heat_from_script_walls"] > 100.0          # J: the floor heats the 300 K bed
     assert summary["heat_from_walls"] == 0.0                  # (the host's own walls: none in the scene)
     assert abs(summary["energy_balance_error"]) < 1e-12
+
+
+@pytest.mark.skipif(not TUTORIAL.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
+def test_a_wall_with_a_temperature_in_the_script_and_in_the_scene_is_refused(tmp_path):
+    """heatTransfer_1 with its floor at 1000 K for heat/gran, and the scene's [[walls]] giving
+    the floor a temperature for collision heat too: heat/gran conducts over each whole wall
+    contact and the host takes its share during a collision back for pairs only, so each wall
+    collision's heat would count twice. Refused at the first run (exit 2), naming the entry,
+    the script's temperature and the two ways out; before, it ran (exit 0) counting it twice."""
+    r, _ = run(hot_floor_case(tmp_path, '[[walls]]\nfix = "zwalls1"\nmaterial = "steel"\ntemperature = 1000.0\n'),
+               "--test")
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "walls[0].temperature: wall 'zwalls1' has a temperature in the script as well (1000. K)" in r.stderr
+    assert "would count twice" in r.stderr and "in [[walls]]" in r.stderr
 
 
 @pytest.mark.skipif(not SOURCES.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")

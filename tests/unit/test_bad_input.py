@@ -101,6 +101,25 @@ def test_a_primitive_wall_placed_by_a_variable_is_read():
                            "in.x", 7))
 
 
+def test_a_script_walls_temperature_is_read_as_written():
+    """The temperature a script gives a wall for its fix heat/gran: a primitive wall/gran's
+    'temperature' keyword, a mesh's in its fix mesh/surface (a number or a $variable, as
+    written); a wall without one has none; an unfixed wall is gone."""
+    from pyhost.script import Command, ScriptInfo
+
+    info = ScriptInfo()
+    for n, line in enumerate(["fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0 "
+                              "temperature 350.", "fix lid all wall/gran model hertz tangential history primitive "
+                              "type 1 zplane 0.1", "fix hot all mesh/surface file a.stl type 1 temperature ${Th}",
+                              "fix cold all mesh/surface file b.stl type 1",
+                              "fix drum all wall/gran model hertz tangential history mesh n_meshes 2 meshes hot cold"]):
+        info.learn(Command(line, "in.x", n + 1))
+    assert info.wall_temperatures("floor") == ["350."] and info.wall_temperatures("lid") == []
+    assert info.wall_temperatures("drum") == ["${Th}"] and info.wall_temperatures("nowhere") == []
+    info.learn(Command("unfix floor", "in.x", 9))
+    assert info.wall_temperatures("floor") == []
+
+
 @pytest.mark.parametrize("line, files", [
     ("dump dmp all custom 5000 ../DEM/post/dump.liggghts_run id type x y z", []),     # LIGGGHTS makes its folder
     ('fix extra all print 100 "${time} ${vx}" file ../DEM/post/velocity.txt title "#" screen no',
