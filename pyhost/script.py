@@ -266,13 +266,22 @@ def _keyword(words: list[str], name: str) -> str | None:
     return words[at[-1] + 1] if at else None
 
 
+def _contact_area(words: list[str]) -> tuple:
+    """A fix wall/gran's ``contact_area`` (its heat conduction's): (mode, constant area as written)."""
+    mode = _keyword(words, "contact_area") or "overlap"
+    at = [k for k in range(4, len(words) - 2) if words[k] == "contact_area"]
+    return (mode, words[at[-1] + 2] if mode == "constant" and at else None)
+
+
 @dataclass(frozen=True)
 class GranWall:
     """A ``fix ID group wall/gran ...``: a primitive wall (``primitive`` = (kind, numbers),
     kind xplane, yplane, zplane, xcylinder, ycylinder or zcylinder; numbers None where the
     script gives them as variables) or mesh walls (``meshes``: ids of their fix mesh/surface).
     ``temperature``: a primitive wall's ``temperature`` as written (a number or a $variable),
-    with which the script's fix heat/gran conducts through its contacts; None: none."""
+    with which the script's fix heat/gran conducts through its contacts; None: none.
+    ``contact_area``: its ``contact_area`` for that conduction, ("overlap" | "projection" |
+    "constant", the constant area as written or None)."""
 
     fix: str
     primitive: tuple | None = None
@@ -280,6 +289,7 @@ class GranWall:
     type: int | None = None
     moving: bool = False
     temperature: str | None = None
+    contact_area: tuple = ("overlap", None)
 
 
 def parse_wall(cmd: Command) -> GranWall | None:
@@ -303,11 +313,12 @@ def parse_wall(cmd: Command) -> GranWall | None:
         except ValueError:
             numbers = None
         return GranWall(w[1], primitive=(kind, numbers), type=wall_type,
-                        moving=any(x in w for x in ("wiggle", "shear", "rotate")), temperature=_keyword(w, "temperature"))
+                        moving=any(x in w for x in ("wiggle", "shear", "rotate")), temperature=_keyword(w, "temperature"),
+                        contact_area=_contact_area(w))
     if "meshes" in w:
         k = w.index("meshes")
         n = int(w[w.index("n_meshes") + 1]) if "n_meshes" in w else 1
-        return GranWall(w[1], meshes=tuple(w[k + 1: k + 1 + n]))
+        return GranWall(w[1], meshes=tuple(w[k + 1: k + 1 + n]), contact_area=_contact_area(w))
     raise ScriptError(f"{cmd.where()}: fix wall/gran with neither 'primitive' nor 'meshes'")
 
 
@@ -331,6 +342,22 @@ class ScriptInfo:
         if wall is None:
             return None
         return wall.type if wall.primitive is not None else self.mesh_types.get(wall.meshes[mesh])
+
+    def conducting_temperature(self, fix: str, mesh: int = 0) -> float | None:
+        """The temperature [K] through which the script's fix heat/gran conducts into the
+        contacts of a wall fix's primitive, or of its mesh number ``mesh``; None: none (or no
+        heat/gran). ScriptError if the script gives it otherwise than as a number."""
+        wall = self.walls.get(fix)
+        if wall is None or self.heat_gran is None:
+            return None
+        word = wall.temperature if wall.primitive is not None else self.mesh_temperatures.get(wall.meshes[mesh])
+        if word is None:
+            return None
+        try:
+            return float(word)
+        except ValueError:
+            raise ScriptError(f"wall {fix}: its temperature {word!r} for heat/gran: the host needs it as a number "
+                              "(to give its collisions heat at it)") from None
 
     def wall_temperatures(self, fix: str) -> list[str]:
         """The temperatures a wall fix's primitive, or its meshes, have in the script (as

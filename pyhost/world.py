@@ -196,8 +196,6 @@ def user_script(scene):
 
     told = set()
 
-    wall_heat = scene.effects_summary()["wall_heat"]
-
     def walls_of(dem):
         info = dem.info
         known = info.walls
@@ -206,24 +204,26 @@ def user_script(scene):
             if w.fix not in known:
                 raise SceneError(f"{scene.path}: walls[{k}].fix: the script has no fix wall/gran {w.fix!r} "
                                  f"before its first run; its walls: {', '.join(known) or 'none'}")
-            conducting = info.wall_temperatures(w.fix) if info.heat_gran else []
-            if conducting and wall_heat and w.temperature > 0:
-                raise SceneError(
-                    f"{scene.path}: walls[{k}].temperature: wall {w.fix!r} has a temperature in the script as well "
-                    f"({' '.join(conducting)} K), through which its fix heat/gran conducts over each whole contact; "
-                    "the host takes heat/gran's share during a collision back for particle pairs, not yet for walls, "
-                    "so each wall collision's heat would count twice. Give the temperature in one place: in the "
-                    "script (LIGGGHTS' conduction only, as without the host) or in [[walls]] (the models' collision "
-                    "heat, with the script's 'temperature' of that wall removed)")
-            named[w.fix] = (materials.index(w.material), w.temperature if w.temperature > 0 else np.nan)
+            for mesh in range(max(len(known[w.fix].meshes), 1)):
+                T = info.conducting_temperature(w.fix, mesh)       # the script's, at which its heat/gran conducts
+                if T is not None and w.temperature > 0 and T != w.temperature:
+                    raise SceneError(f"{scene.path}: walls[{k}].temperature: {w.temperature:g} K, where the script "
+                                     f"gives wall {w.fix!r} {T:g} K (its fix heat/gran conducts at it): one wall, one "
+                                     "temperature")
+                named[w.fix, mesh] = (materials.index(w.material), w.temperature if w.temperature > 0 else np.nan)
+                if T is not None and w.temperature == 0 and (w.fix, mesh) not in told:
+                    print(f"LIGGGHTS wall {w.fix!r}: adiabatic for collision heat, though the script's fix heat/gran "
+                          f"conducts through it at {T:g} K: give its [[walls]] entry temperature = {T:g} for the "
+                          "models' collision heat")
         for fix in known:
-            if fix not in named and fix not in told:
+            if fix not in {f for f, _ in named} and fix not in told:
                 conducting = info.wall_temperatures(fix) if info.heat_gran else []
                 print(f"LIGGGHTS wall {fix!r} has no [[walls]] entry: adiabatic for collision heat"
                       + (f" (the script's fix heat/gran conducts through its contacts at {' '.join(conducting)} K, "
                          "as LIGGGHTS does)" if conducting else ""))
         told.update(known)
-        return [HostWall(f, *named.get(f, (-1, np.nan)), mesh=k)
+        told.update(named)
+        return [HostWall(f, *named.get((f, k), (-1, np.nan)), mesh=k)
                 for f, wall in known.items() for k in range(max(len(wall.meshes), 1))]
 
     return dict(type_material=type_material, known=Known("type", type_group, T_of_type, tuple(names)),

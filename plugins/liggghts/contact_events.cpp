@@ -21,6 +21,12 @@
 // sqrt(A), A from the overlap, area-corrected, or constant, or projected): the host takes back
 // what heat/gran moved during the collision's model time (pyhost.loop.Coupling.harvest). A
 // history is handed over once full, or when its contact ends (collheat_events_histories).
+// So does each new contact with a wall through which heat/gran conducts and whose collisions
+// the host gives heat (collheat_events_wall_conduction: the wall's temperature, atom type and
+// contact area mode, as fix wall/gran's addHeatFlux takes them: flux into the particle =
+// (T_wall - T_i) 4 k_i k_w / (k_i + k_w) sqrt(A), A = pi (R^2 - (R - delta)^2) from the overlap
+// delta (area-corrected as heat/gran corrects), or constant, or projected; on a mesh, through
+// its deepest triangle).
 //
 // With heat/gran the recorder also sums, at every step (not at a run's set-up), what its
 // transport equation adds to the particles' m c Temp when it integrates (final_integrate, after
@@ -94,7 +100,13 @@ constexpr double IMPOSED = 1.0, MOVED = 2.0;
 constexpr int HEAD = 4; // a flux history: i, j (ids, i < j), step of the begin, steps kept; then the fluxes
 enum Area { OVERLAP = 0, CONSTANT = 1, PROJECTION = 2 };   // FixHeatGranCond's contact area modes
 
-struct History {                               // a new pair contact's heat/gran flux [W] into i, per step
+struct WallHeat {                              // a wall heat/gran conducts through: its temperature [K]
+    double T;                                  // (< 0: none, or its collisions get no host heat), atom type,
+    int type, mode;                            // contact area mode (Area) and constant area [m^2]
+    double area;
+};
+
+struct History {                               // a new pair (or wall) contact's heat/gran flux [W] into i, per step
     uint64_t key;
     bigint start;
     int filled;
@@ -110,6 +122,7 @@ struct Recorder {
     std::vector<double> prim_code;             // code the host gives their contacts
     std::vector<FixMeshSurface *> meshes;       // mesh walls: the fix mesh/surface and the code
     std::vector<double> mesh_code;             // of its contacts (one per particle and mesh: the deepest)
+    std::vector<WallHeat> prim_heat, mesh_heat; // with heat/gran: the walls it conducts through (as prims, meshes)
     std::vector<double> depth, normal;         // per local atom, this call and mesh: overlap [m] and normal,
     std::vector<int> deepest;                  // and the deepest triangle (meshes without a contact history)
     bool new_walls = false;                   // walls given since the last call: what touches them is open
@@ -160,7 +173,7 @@ struct Recorder {
     // approach speed vn, normal n). With heat/gran, a BEGIN carries the two temperatures of
     // that step: heat/gran changes them before the host takes the event.
     inline void on(size_t k, bigint step, bool rebuilt, int kind, uint64_t k_, double i, double j, int li, int lj,
-                   double vn, const double *n, bool quiet = false)
+                   double vn, const double *n, bool quiet = false, bool conducts = false)
     {
         if (touch[k] && !rebuilt) return;
         touch[k] = 1;
@@ -181,7 +194,7 @@ struct Recorder {
             event(kind, step, i, j, vn, n, 0.0, T ? T[li] : NAN, T && lj >= 0 ? T[lj] : NAN,
                   rebuilt && lmp->comm->nprocs > 1 ? MOVED : 0.0);
             ++begun;
-            if (conduction && kind == PAIR_BEGIN) history[k] = open_history(k_, step);
+            if (conduction && (kind == PAIR_BEGIN || conducts)) history[k] = open_history(k_, step);
         }
     }
 
@@ -233,16 +246,50 @@ struct Recorder {
         return (conduction->Temp[j] - conduction->Temp[i]) * hc;
     }
 
-    // Slot k (atoms i, j in contact now, |x_i - x_j|^2 = rsq): its flux at this step into the smaller id.
-    void conduct(size_t k, int i, int j, double rsq, bigint step)
+    // heat/gran's flux [W] into local atom i from wall h now, at overlap delta [m]
+    // (FixWallGran::addHeatFlux; its conductivities are heat/gran's thermalConductivity).
+    double wall_flux(int i, double delta, const WallHeat &h) const
+    {
+        const double R = lmp->atom->radius[i];
+        const int type = lmp->atom->type[i];
+        double area;
+        if (h.mode == CONSTANT)
+            area = h.area;
+        else if (h.mode == PROJECTION)
+            area = M_PI * R * R;
+        else {
+            if (conduction->area_correction_flag_ && conduction->deltan_ratio_)
+                delta *= conduction->deltan_ratio_[type - 1][h.type - 1];
+            const double r = R - delta;
+            area = (R * R - r * r) * M_PI;
+        }
+        const double kp = conduction->conductivity_[type - 1], kw = conduction->conductivity_[h.type - 1];
+        const double SMALL = 1e-12;                        // (fix_wall_gran.cpp's)
+        const double hc = (std::fabs(kp) < SMALL || std::fabs(kw) < SMALL) ? 0.0 : 4. * kp * kw / (kp + kw) * std::sqrt(area);
+        return (h.T - conduction->Temp[i]) * hc;
+    }
+
+    // Slot k's flux at this step, into the smaller id (a wall's: into the particle), kept in its history.
+    void keep(size_t k, double into_lo, bigint step)
     {
         History &y = histories[history[k]];
         const bigint age = step - y.start;
         if (age < 0 || age >= window) return;
-        const double into_i = heat_gran_flux(i, j, rsq);
-        y.flux[age] = lmp->atom->tag[i] < lmp->atom->tag[j] ? into_i : -into_i;
+        y.flux[age] = into_lo;
         y.filled = int(age) + 1;
         if (y.filled == window) { close_history(history[k]); history[k] = -1; }
+    }
+
+    // Slot k (atoms i, j in contact now, |x_i - x_j|^2 = rsq): its flux at this step into the smaller id.
+    void conduct(size_t k, int i, int j, double rsq, bigint step)
+    {
+        const double into_i = heat_gran_flux(i, j, rsq);
+        keep(k, lmp->atom->tag[i] < lmp->atom->tag[j] ? into_i : -into_i, step);
+    }
+
+    bool conducts(const std::vector<WallHeat> &heat, size_t w) const
+    {
+        return conduction && w < heat.size() && heat[w].T >= 0;
     }
 
     // Slot k not in contact now: an END if it was (between builds; at a build, what is left
@@ -352,7 +399,28 @@ struct Recorder {
         const double vn = -((v[i][0] - vw[0]) * n[0] + (v[i][1] - vw[1]) * n[1] + (v[i][2] - vw[2]) * n[2]);
         const int *tag = lmp->atom->tag;
         on(k, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]), tag[i], mesh_code[m],
-           i, -1, vn, n, new_walls);
+           i, -1, vn, n, new_walls, conducts(mesh_heat, m));
+    }
+
+    // Particle i's deepest partner triangle in mesh m's contact history: its index (-1: none
+    // touches), overlap dn < 0 [m] and normal.
+    int deepest_partner(FixContactHistoryMesh *hist, TriMesh *mesh, int i, double &best, double *n) const
+    {
+        int t_best = -1;
+        best = 0;
+        for (int j = 0; j < hist->nneighs(i); ++j) {
+            const int id = hist->get_partner_idTri(i, j);
+            if (id < 0) continue;
+            for (int c = 0; c < mesh->map_size(id); ++c) {
+                const int t = mesh->map(id, c);
+                if (t < 0) continue;
+                double dn, nt[3];
+                if (!tri_contact(mesh, i, t, dn, nt)) continue;
+                if (t_best < 0 || dn < best) { best = dn; t_best = t; n[0] = nt[0]; n[1] = nt[1]; n[2] = nt[2]; }
+                break;
+            }
+        }
+        return t_best;
     }
 
     // Whether every fix wall/gran comes before this fix: their post_force (and the mesh
@@ -512,14 +580,17 @@ struct Recorder {
                 const int i = near[c];
                 if (i >= nlocal) continue;
                 const size_t kk = k + i;
-                double delta[3] = {0, 0, 0};
-                if (!(mask[i] & groupbit) || wall->resolveContact(x[i], r[i], delta) > 0) { off(kk, step, rebuilt); continue; }
-                if (touch[kk] && !rebuilt) continue;
-                const double len = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
-                const double d = len > 0 ? -len : 1.0;          // (a division: a plane's normal is +-1 exactly)
-                const double n[3] = {delta[0] / d, delta[1] / d, delta[2] / d};
-                on(kk, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(prim_code[w]), tag[i], prim_code[w],
-                   i, -1, -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]), n, new_walls);
+                double delta[3] = {0, 0, 0}, dn = 1.0;
+                if (!(mask[i] & groupbit) || (dn = wall->resolveContact(x[i], r[i], delta)) > 0) { off(kk, step, rebuilt); continue; }
+                if (!touch[kk] || rebuilt) {
+                    const double len = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
+                    const double d = len > 0 ? -len : 1.0;      // (a division: a plane's normal is +-1 exactly)
+                    const double n[3] = {delta[0] / d, delta[1] / d, delta[2] / d};
+                    on(kk, step, rebuilt, WALL_BEGIN, (uint64_t(tag[i]) << 31) | uint64_t(prim_code[w]), tag[i],
+                       prim_code[w], i, -1, -(v[i][0] * n[0] + v[i][1] * n[1] + v[i][2] * n[2]), n, new_walls,
+                       conducts(prim_heat, w));
+                }
+                if (history[kk] >= 0) keep(kk, wall_flux(i, -dn, prim_heat[w]), step);
             }
         }
         // mesh walls. Where LIGGGHTS keeps a contact history of the mesh (fix wall/gran with
@@ -544,29 +615,19 @@ struct Recorder {
                 ++meshes_by_history;
                 for (int i = 0; i < nlocal; ++i, ++k) {
                     if (hist->n_partner(i) == 0) { off(k, step, rebuilt); continue; }
-                    if (touch[k] && !rebuilt) continue;
                     const uint64_t key_ = (uint64_t(tag[i]) << 31) | uint64_t(mesh_code[m]);
-                    const double zero[3] = {0, 0, 0};
-                    if (rebuilt && carry.count(key_)) {             // open before the build
-                        on(k, step, rebuilt, WALL_BEGIN, key_, tag[i], mesh_code[m], i, -1, 0.0, zero);
+                    double best = 0, n[3] = {0, 0, 0};
+                    if ((touch[k] && !rebuilt) || (rebuilt && carry.count(key_))) {     // open (before the build)
+                        const double zero[3] = {0, 0, 0};
+                        if (rebuilt) on(k, step, rebuilt, WALL_BEGIN, key_, tag[i], mesh_code[m], i, -1, 0.0, zero);
+                        if (history[k] >= 0 && deepest_partner(hist, mesh, i, best, n) >= 0)
+                            keep(k, wall_flux(i, -best, mesh_heat[m]), step);
                         continue;
                     }
-                    double best = 0, n[3] = {0, 0, 0};
-                    int t_best = -1;
-                    for (int j = 0; j < hist->nneighs(i); ++j) {
-                        const int id = hist->get_partner_idTri(i, j);
-                        if (id < 0) continue;
-                        for (int c = 0; c < mesh->map_size(id); ++c) {
-                            const int t = mesh->map(id, c);
-                            if (t < 0) continue;
-                            double dn, nt[3];
-                            if (!tri_contact(mesh, i, t, dn, nt)) continue;
-                            if (t_best < 0 || dn < best) { best = dn; t_best = t; n[0] = nt[0]; n[1] = nt[1]; n[2] = nt[2]; }
-                            break;
-                        }
-                    }
+                    const int t_best = deepest_partner(hist, mesh, i, best, n);
                     if (t_best < 0) { off(k, step, rebuilt); continue; }    // (a partner LIGGGHTS has not cleaned up)
                     begin_on_mesh(k, step, rebuilt, m, mesh, i, t_best, n);
+                    if (history[k] >= 0) keep(k, wall_flux(i, -best, mesh_heat[m]), step);
                 }
                 continue;
             }
@@ -586,8 +647,8 @@ struct Recorder {
             }
             for (int i = 0; i < nlocal; ++i, ++k) {
                 if (depth[i] >= 0) { off(k, step, rebuilt); continue; }
-                if (touch[k] && !rebuilt) continue;
-                begin_on_mesh(k, step, rebuilt, m, mesh, i, deepest[i], &normal[3 * i]);
+                if (!touch[k] || rebuilt) begin_on_mesh(k, step, rebuilt, m, mesh, i, deepest[i], &normal[3 * i]);
+                if (history[k] >= 0) keep(k, wall_flux(i, -depth[i], mesh_heat[m]), step);
             }
         }
         if (rebuilt) {                         // contacts of the old layout not found again: ended
@@ -706,6 +767,26 @@ int collheat_events_conduction(void *handle, const char *fix_id, int window)
     if (f < 0 || std::strncmp(rec->lmp->modify->fix[f]->style, "heat/gran", 9) != 0 || window < 1) return -1;
     rec->conduction = static_cast<FixHeatGranCond *>(rec->lmp->modify->fix[f]);
     rec->window = window;
+    return 0;
+}
+
+// The walls heat/gran conducts through whose collisions the host gives heat, of the primitive
+// walls (`meshes` 0) or the mesh walls (1) as last given: 4 numbers per wall, in their order:
+// temperature [K] (< 0: none), atom type, contact area mode (0 overlap, 1 constant, 2
+// projection), constant area [m^2]. Their new contacts keep flux histories as pairs do. -1 if
+// n is not the number of such walls or a type is out of range.
+int collheat_events_wall_conduction(void *handle, int meshes, int n, const double *params)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    if (size_t(n) != (meshes ? rec->meshes.size() : rec->prims.size())) return -1;
+    std::vector<WallHeat> heat;
+    for (int w = 0; w < n; ++w) {
+        const double *p = params + 4 * w;
+        const int type = int(p[1]);
+        if (p[0] >= 0 && (type < 1 || type > rec->lmp->atom->ntypes)) return -1;
+        heat.push_back(WallHeat{p[0], type, int(p[2]), p[3]});
+    }
+    (meshes ? rec->mesh_heat : rec->prim_heat) = heat;
     return 0;
 }
 

@@ -210,7 +210,8 @@ class EnergyBalance(Effect):
                         + abs(t["heat_from_sources"]) + abs(t["heat_from_script_walls"]))
         self.residual = (CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]
                          - t["energy_set_by_script"] - t["energy_mass_change"] - t["heat_convected"]
-                         - t["heat_from_sources"] - t["heat_from_script_walls"])   # J
+                         - t["heat_from_sources"] - t["heat_from_script_walls"]
+                         + t.get("heat_gran_walls_undone", 0.0))   # J (heat/gran's walls during collisions: taken back)
         error = self.residual / max(self.came_in, 1e-300)       # relative to all that came in
         summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=error)
         if status == "completed" and not abs(error) <= TOLERANCE:

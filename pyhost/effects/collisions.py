@@ -60,7 +60,8 @@ class CollisionHeat(Effect):
     ``logs``: the checkpoint's output marks to continue from (None: a new run)."""
 
     TOTALS = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0, heat_from_walls=0.0,
-                  capped=0, clipped=0, heat_gran_undone=0.0, outside_model_range=0)
+                  capped=0, clipped=0, heat_gran_undone=0.0, heat_gran_walls_undone=0.0,
+                  outside_model_range=0)
 
     def __init__(self, loop, walls, logs: dict | None = None):
         super().__init__(loop)
@@ -97,7 +98,8 @@ class CollisionHeat(Effect):
         self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
         self.T_wall = np.array([w.temperature if self.loop.effects["wall_heat"] else np.nan for w in walls])
         self.wall_material = np.array([w.material for w in walls], int)
-        self.dem.event_walls(self.wall_index)
+        heated = {(w.fix, w.mesh) for w, T in zip(walls, self.T_wall) if np.isfinite(T)}
+        self.conducting = self.dem.event_walls(self.wall_index, heated)   # codes: heat/gran's share taken back
 
     def after_chunk(self, due: dict) -> None:
         """The contacts' work at the end of a DEM chunk: the events harvested, if due. Under MPI
@@ -335,8 +337,8 @@ class CollisionHeat(Effect):
             return []
         cols = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["step"] * self.dem.dt,
                             T_begin=begin["T"])
-        if self.dem.events.window:              # each pair collision's model time, until its flux history comes
-            pair = ~begin["wall"]
+        if self.dem.events.window:              # each collision's model time, until its flux history comes
+            pair = ~begin["wall"] | np.isin(begin["j"], list(self.conducting))
             keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
             self.t_coll_of.update(zip(zip(keys, begin["step"][pair].tolist()), cols["t_coll"][pair].tolist()))
         return [(cols, begin["step"], begin["j"], begin)]
@@ -366,7 +368,10 @@ class CollisionHeat(Effect):
         collision's model duration t_coll, taken back (the collision heat stands for that time):
         from the recorder's flux history of the contact, step m from the begin carrying flux f_m
         [W] over dt, Q = dt sum_m f_m clip(t_coll / dt - m, 0, 1) [J] into the smaller id. Exact
-        per step."""
+        per step. So for a new contact with a wall through which heat/gran conducts and whose
+        collisions get heat (``conducting``): Q into the particle, taken from it, counted in
+        ``heat_gran_walls_undone`` (heat the script's walls gave, which the balance counts in
+        heat_from_script_walls)."""
         i, j, start, filled, flux = self.dem.events.histories(all=final)
         if not len(i):
             return
@@ -382,8 +387,14 @@ class CollisionHeat(Effect):
         share = np.clip(np.nan_to_num(steps)[:, None] - np.arange(window), 0.0, 1.0)
         share[np.arange(window) >= filled[:, None]] = 0.0
         q = dt * np.sum(flux * share, axis=1)              # heat heat/gran moved into i [J]
-        a, b = atoms.index(i), atoms.index(j)
-        ok = np.isfinite(t_coll) & (a >= 0) & (b >= 0) & (q != 0)
+        wall = j >= WALL_BASE
+        a, b = atoms.index(i), np.where(wall, -1, atoms.index(np.where(wall, 0, j)))
+        ok = np.isfinite(t_coll) & (a >= 0) & ((b >= 0) | wall) & (q != 0)
+        on_wall = ok & wall
+        if on_wall.any():
+            np.subtract.at(atoms.T, a[on_wall], q[on_wall] / self.loop.C[a[on_wall]])
+            self.totals["heat_gran_walls_undone"] += float(q[on_wall].sum())
+        ok &= ~wall
         a, b, q = a[ok], b[ok], q[ok]
         np.subtract.at(atoms.T, a, q / self.loop.C[a])
         np.add.at(atoms.T, b, q / self.loop.C[b])

@@ -447,8 +447,11 @@ class Dem:
         return self.events is not None and self.events.window > 0
 
     # -- contacts ---------------------------------------------------------------------
-    def event_walls(self, wall_index: dict) -> None:
-        """The primitive and mesh walls, for the event recorder, with their contact codes."""
+    def event_walls(self, wall_index: dict, heated=()) -> set:
+        """The primitive and mesh walls, for the event recorder, with their contact codes; of
+        the ``heated`` ones ((fix, mesh) whose collisions the host gives heat), those through
+        which the script's fix heat/gran conducts (a temperature in the script) keep its flux
+        through each new contact (``wall_conduction``). Returns their codes."""
         primitive = [(fix, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items() if w.primitive is not None]
         if not self.events.primitives(*(zip(*primitive) if primitive else ([], []))):
             raise ScriptError(f"the primitive walls {', '.join(f for f, _ in primitive)}: one is not a fix wall/gran "
@@ -460,3 +463,21 @@ class Dem:
             raise ScriptError(f"the mesh walls {names}: the contact recorder finds no neighbour list of a fix "
                               "wall/gran on them (every fix wall/gran of LIGGGHTS 3.8 makes one): their "
                               "collisions cannot be seen")
+        if not self.has_heat_flux():
+            return set()
+        conducting = set()
+        for meshes, walls in ((False, [(fix, 0) for fix, _ in primitive]),
+                              (True, [(fix, k) for fix, w in self.info.walls.items() for k in range(len(w.meshes or ()))])):
+            params = []
+            for fix, k in walls:
+                T = self.info.conducting_temperature(fix, k) if (fix, k) in heated else None
+                mode, area = self.info.walls[fix].contact_area
+                params.append((-1.0 if T is None else T, self.info.wall_type(fix, k) or 0,
+                               ("overlap", "constant", "projection").index(mode) if mode in ("constant", "projection")
+                               else 0, float(area) if mode == "constant" else 0.0))
+                if T is not None:
+                    conducting.add(WALL_BASE + wall_index[fix, k])
+            if not self.events.wall_conduction(meshes, params):
+                raise ScriptError(f"walls {', '.join(f for f, _ in walls)}: the contact recorder cannot follow "
+                                  "heat/gran's conduction through them (an atom type out of range?)")
+        return conducting

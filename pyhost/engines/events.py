@@ -61,6 +61,7 @@ _DECLARATIONS = {
     "collheat_events_take": (_int, [_vp, _dp, _int]),
     "collheat_events_free": (None, [_vp]),
     "collheat_events_conduction": (_int, [_vp, _c.c_char_p, _int]),
+    "collheat_events_wall_conduction": (_int, [_vp, _int, _int, _dp]),
     "collheat_events_histories": (_int, [_vp, _int]),
     "collheat_events_take_histories": (_int, [_vp, _dp, _int]),
     "collheat_events_appeared": (_int, [_vp, _dp, _int]),
@@ -153,6 +154,16 @@ class ContactEvents:
         arr = (_c.c_char_p * len(ids))(*[i.encode() for i in ids])
         codes = np.ascontiguousarray(codes, dtype=float)
         return self.lmp.helper.collheat_events_primitives(self.handle, len(ids), arr, codes.ctypes.data_as(_dp)) >= 0
+
+    def wall_conduction(self, meshes: bool, params) -> bool:
+        """The walls (of the primitives or the meshes, as last given, in their order) through
+        which the script's fix heat/gran conducts and whose collisions the host gives heat:
+        (temperature [K], < 0: none; atom type; contact area mode 0 overlap, 1 constant, 2
+        projection; constant area [m^2]) for each. Their new contacts keep flux histories as
+        pairs do (``histories``, the wall's code as j). False if that is not one per wall."""
+        params = np.ascontiguousarray(np.reshape(params, (-1, 4)), dtype=float)
+        return self.lmp.helper.collheat_events_wall_conduction(self.handle, int(meshes), len(params),
+                                                               params.ctypes.data_as(_dp)) == 0
 
     def meshes(self, ids, codes) -> bool:
         """Mesh walls: the ``fix mesh/surface`` id and the partner code of each. False (and
@@ -289,6 +300,9 @@ class RankEvents:
 
     def meshes(self, ids, codes) -> bool:
         return all(self._all("meshes", list(ids), list(codes)))
+
+    def wall_conduction(self, meshes: bool, params) -> bool:
+        return all(self._all("wall_conduction", meshes, np.asarray(params)))
 
     def prime(self) -> None:
         self._all("prime")

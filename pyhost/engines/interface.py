@@ -117,8 +117,11 @@ class DemEngine(Protocol):
         """Whether the script's fix heat/gran's conduction per contact can be read."""
 
     # -- contacts ----------------------------------------------------------------------
-    def event_walls(self, wall_index: dict) -> None:
-        """Hand the recorder the walls it records contacts with, by their host codes."""
+    def event_walls(self, wall_index: dict, heated=()) -> set:
+        """Hand the recorder the walls it records contacts with, by their host codes; of the
+        ``heated`` ones ((fix, mesh) whose collisions the host gives heat), those through which
+        the script's heat/gran conducts keep its flux through each new contact as pairs do.
+        Returns those walls' codes."""
 
     # -- what a checkpoint keeps that the engine's restart does not ------------------------
     def mesh_motion_times(self) -> dict:

@@ -150,17 +150,25 @@ def test_heat_gran_wall_with_a_temperature_enters_the_balance(tmp_path):
 
 
 @pytest.mark.skipif(not TUTORIAL.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
-def test_a_wall_with_a_temperature_in_the_script_and_in_the_scene_is_refused(tmp_path):
+def test_a_hot_script_wall_in_the_scene_gets_collision_heat_and_heat_grans_share_back(tmp_path):
     """heatTransfer_1 with its floor at 1000 K for heat/gran, and the scene's [[walls]] giving
-    the floor a temperature for collision heat too: heat/gran conducts over each whole wall
-    contact and the host takes its share during a collision back for pairs only, so each wall
-    collision's heat would count twice. Refused at the first run (exit 2), naming the entry,
-    the script's temperature and the two ways out; before, it ran (exit 0) counting it twice."""
-    r, _ = run(hot_floor_case(tmp_path, '[[walls]]\nfix = "zwalls1"\nmaterial = "steel"\ntemperature = 1000.0\n'),
-               "--test")
+    the floor the same temperature for collision heat: its collisions move the models' heat,
+    what heat/gran conducted through each during the model's t_coll is taken back from the
+    particle (heat_gran_walls_undone, as for pairs), and the balance closes. Before, the two
+    were both counted (exit 0). A [[walls]] temperature other than the script's is refused at
+    the first run (exit 2), naming both."""
+    walls = '[[walls]]\nfix = "zwalls1"\nmaterial = "steel"\ntemperature = {T}\n'
+    r, summary = run(hot_floor_case(tmp_path, walls.format(T=1000.0)), "--test")
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    print(f"wall collisions {summary['particle_wall']}, heat_from_walls {summary['heat_from_walls']:.6g} J, "
+          f"heat_gran_walls_undone {summary['heat_gran_walls_undone']:.6g} J, heat_from_script_walls "
+          f"{summary['heat_from_script_walls']:.6g} J, balance {summary['energy_balance_error']:.3g}")
+    assert summary["particle_wall"] > 0 and summary["heat_from_walls"] > 0.0
+    assert 0.0 < summary["heat_gran_walls_undone"] < summary["heat_from_script_walls"]
+    assert abs(summary["energy_balance_error"]) < 1e-12
+    r, _ = run(hot_floor_case(tmp_path / "other", walls.format(T=900.0)), "--test")
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
-    assert "walls[0].temperature: wall 'zwalls1' has a temperature in the script as well (1000. K)" in r.stderr
-    assert "would count twice" in r.stderr and "in [[walls]]" in r.stderr
+    assert "walls[0].temperature: 900 K, where the script gives wall 'zwalls1' 1000 K" in r.stderr
 
 
 @pytest.mark.skipif(not SOURCES.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")

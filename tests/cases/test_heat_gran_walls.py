@@ -1,0 +1,131 @@
+"""A script's fix heat/gran conducting from a hot wall, against plain LIGGGHTS: one glass sphere
+dropped 0.1 mm onto a floor at 350 K (a primitive plane, ``fix wall/gran ... temperature 350.``,
+or a mesh of two triangles, ``fix mesh/surface ... temperature 350.``; the sphere lands off
+their common edge), the
+scene's [[walls]] giving the floor the same temperature for the models' collision heat. The
+host takes back what heat/gran conducted through the wall contact during each collision's
+model time t_coll (pyhost.effects.collisions.take_back_heat_gran); LIGGGHTS run alone, its
+sphere's Temp dumped at every step, gives that share independently."""
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import glass_toml, steel_toml
+
+pytestmark = pytest.mark.engines
+ROOT = Path(__file__).resolve().parents[2]
+
+SCRIPT = """atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+region box block 0 0.02 0 0.02 0 0.02 units box
+create_box 1 box
+neighbor 0.0005 bin
+neigh_modify delay 0
+fix m1 all property/global youngsModulus peratomtype 5e6
+fix m2 all property/global poissonsRatio peratomtype 0.3
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.8
+fix m4 all property/global coefficientFriction peratomtypepair 1 0.3
+fix m5 all property/global thermalConductivity peratomtype 1.0
+fix m6 all property/global thermalCapacity peratomtype 840
+pair_style gran model hertz tangential history
+pair_coeff * *
+timestep 1e-6
+fix gravi all gravity 9.81 vector 0 0 -1
+{floor}
+create_atoms 1 single 0.006 0.012 0.0011 units box
+set group all diameter 0.002 density 2500
+fix heattransfer all heat/gran initial_temperature 300.
+fix integr all nve/sphere
+{dump}run 5200
+"""
+
+SCENE = f"""[dem]
+script = "in.drop"
+[effects]
+contact_heat = "A"
+{glass_toml(temperature="temperature = 0.0")}
+{steel_toml()}
+[[walls]]
+fix = "floor"
+material = "steel"
+temperature = 350.0
+[output]
+vtk = false
+pictures = false
+"""
+
+
+FLOORS = {
+    "primitive": "fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0 temperature 350.",
+    "mesh": "fix plate all mesh/surface file floor.stl type 1 temperature 350.\n"
+            "fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes plate",
+}
+STL = """solid floor
+facet normal 0 0 1
+outer loop
+vertex 0 0 0
+vertex 0.02 0 0
+vertex 0.02 0.02 0
+endloop
+endfacet
+facet normal 0 0 1
+outer loop
+vertex 0 0 0
+vertex 0.02 0.02 0
+vertex 0 0.02 0
+endloop
+endfacet
+endsolid floor
+"""
+
+
+@pytest.mark.parametrize("floor", FLOORS)
+def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(floor, tmp_path):
+    """The sphere's first impact (about 4,500 steps of 1 us down, v0 = 0.044 m/s, t_coll about 10 steps): heat/gran's share
+    during t_coll, taken back by the host, equals m c times the sphere's Temp rises in plain
+    LIGGGHTS over the contact's first t_coll / dt steps (the last one in part), to 1e-9; the
+    models' heat is moved instead (heat_from_walls > 0), and the balance closes to 1e-12."""
+    native = tmp_path / "native"
+    native.mkdir()
+    (native / "floor.stl").write_text(STL)
+    (native / "in.drop").write_text(SCRIPT.format(floor=FLOORS[floor], dump="dump t all custom 1 temp.dump id f_Temp[0]\n"
+                                                           'dump_modify t format "%d %.17g"\n'))
+    r = subprocess.run(["liggghts", "-in", "in.drop", "-screen", "/dev/null", "-log", "none"], cwd=native,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout[-2000:]
+    lines = (native / "temp.dump").read_text().splitlines()
+    T = np.array([float(lines[k + 9].split()[1]) for k in range(0, len(lines), 10)])   # one atom: 10 lines a step
+    rises = np.diff(T)                    # Temp after step s+1 less after step s: heat/gran's flux of step s+1
+    first = int(np.flatnonzero(rises)[0])
+
+    case = tmp_path / "host"
+    case.mkdir()
+    (case / "floor.stl").write_text(STL)
+    (case / "in.drop").write_text(SCRIPT.format(floor=FLOORS[floor], dump=""))
+    (case / "case.toml").write_text(SCENE)
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--out", str(case / "out")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    summary = json.loads((case / "out" / "summary.json").read_text())
+    with open(case / "out" / "collisions.csv") as f:
+        rows = list(csv.DictReader(f))
+    dt, m_c = 1e-6, 2500.0 * 4.0 / 3.0 * np.pi * 0.001**3 * 840.0
+    t_coll = float(rows[0]["t_coll"])
+    share = np.clip(t_coll / dt - np.arange(len(rises) - first), 0.0, 1.0)
+    expected = m_c * float(np.sum(rises[first:] * share))
+    print(f"{len(rows)} wall collisions, first at step {first + 1}, v0 {float(rows[0]['v0']):.4f} m/s, t_coll "
+          f"{t_coll:.3e} s; heat/gran in t_coll: LIGGGHTS {expected:.6e} J, taken back "
+          f"{summary['heat_gran_walls_undone']:.6e} J; models' heat {summary['heat_from_walls']:.6e} J")
+    assert len(rows) == 1 and abs(float(rows[0]["time"]) - (first + 1) * dt) < 0.5 * dt
+    assert 5.0 < t_coll / dt < 50.0 and expected > 0.0
+    assert summary["heat_gran_walls_undone"] == pytest.approx(expected, rel=1e-9)
+    assert summary["heat_from_walls"] > 0.0
+    assert abs(summary["energy_balance_error"]) < 1e-12
