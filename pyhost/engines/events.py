@@ -230,7 +230,7 @@ class ContactEvents:
             self.handle = None
 
 
-GATHERED = {"take", "histories", "appeared", "primitives", "meshes", "waiting", "open_count", "totals",
+GATHERED = {"take", "histories", "appeared", "primitives", "meshes", "wall_conduction", "waiting", "open_count", "totals",
             "heat_gran_heat"}
 """What each rank answers to rank 0 (the others' recorders change only their own state)."""
 

@@ -1,20 +1,21 @@
 """A script's fix heat/gran conducting from a hot wall, against plain LIGGGHTS: one glass sphere
 dropped 0.1 mm onto a floor at 350 K (a primitive plane, ``fix wall/gran ... temperature 350.``,
 or a mesh of two triangles, ``fix mesh/surface ... temperature 350.``; the sphere lands off
-their common edge), the
+their common edge; the plane also with the host on two MPI ranks), the
 scene's [[walls]] giving the floor the same temperature for the models' collision heat. The
 host takes back what heat/gran conducted through the wall contact during each collision's
 model time t_coll (pyhost.effects.collisions.take_back_heat_gran); LIGGGHTS run alone, its
 sphere's Temp dumped at every step, gives that share independently."""
 import csv
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import glass_toml, steel_toml
+from conftest import FLOOR_STL, glass_toml, steel_toml
 
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
@@ -65,37 +66,20 @@ pictures = false
 
 FLOORS = {
     "primitive": "fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0 temperature 350.",
-    "mesh": "fix plate all mesh/surface file floor.stl type 1 temperature 350.\n"
+    "mesh": "fix plate all mesh/surface file floor.stl type 1 move 0.01 0.01 0. temperature 350.\n"
             "fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes plate",
 }
-STL = """solid floor
-facet normal 0 0 1
-outer loop
-vertex 0 0 0
-vertex 0.02 0 0
-vertex 0.02 0.02 0
-endloop
-endfacet
-facet normal 0 0 1
-outer loop
-vertex 0 0 0
-vertex 0.02 0.02 0
-vertex 0 0.02 0
-endloop
-endfacet
-endsolid floor
-"""
 
 
-@pytest.mark.parametrize("floor", FLOORS)
-def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(floor, tmp_path):
+@pytest.mark.parametrize("floor, ranks", [("primitive", 1), ("mesh", 1), ("primitive", 2)])
+def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(floor, ranks, tmp_path):
     """The sphere's first impact (about 4,500 steps of 1 us down, v0 = 0.044 m/s, t_coll about 10 steps): heat/gran's share
     during t_coll, taken back by the host, equals m c times the sphere's Temp rises in plain
     LIGGGHTS over the contact's first t_coll / dt steps (the last one in part), to 1e-9; the
     models' heat is moved instead (heat_from_walls > 0), and the balance closes to 1e-12."""
     native = tmp_path / "native"
     native.mkdir()
-    (native / "floor.stl").write_text(STL)
+    (native / "floor.stl").write_text(FLOOR_STL)
     (native / "in.drop").write_text(SCRIPT.format(floor=FLOORS[floor], dump="dump t all custom 1 temp.dump id f_Temp[0]\n"
                                                            'dump_modify t format "%d %.17g"\n'))
     r = subprocess.run(["liggghts", "-in", "in.drop", "-screen", "/dev/null", "-log", "none"], cwd=native,
@@ -108,11 +92,13 @@ def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(flo
 
     case = tmp_path / "host"
     case.mkdir()
-    (case / "floor.stl").write_text(STL)
+    (case / "floor.stl").write_text(FLOOR_STL)
     (case / "in.drop").write_text(SCRIPT.format(floor=FLOORS[floor], dump=""))
     (case / "case.toml").write_text(SCENE)
-    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--out", str(case / "out")],
-                       capture_output=True, text=True, cwd=ROOT, timeout=600)
+    mpirun = ["mpirun", "--oversubscribe", "-np", str(ranks)] if ranks > 1 else []
+    r = subprocess.run(mpirun + [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(case / "out")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=600,
+                       env=dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1"))
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     summary = json.loads((case / "out" / "summary.json").read_text())
     with open(case / "out" / "collisions.csv") as f:
