@@ -150,7 +150,9 @@ class Wall:
     plane: str = spec("in:," + ",".join(FACES), "", "which face of the box (box scenes)")
     fix: str = spec(default="", doc="id of the script's fix wall/gran, primitive or mesh (script scenes)")
     temperature: float = spec(">=0", 0.0, "fixed temperature [K] (for collisions; with effects.convection also "
-                                           "the gas at that side of a box scene); 0 means adiabatic")
+                                           "the gas at that side of a box scene); 0 means adiabatic; a script's "
+                                           "wall with a temperature for its fix heat/gran needs the same one here "
+                                           "(heat/gran's share during each collision is then taken back)")
 
 
 @dataclass(frozen=True)
