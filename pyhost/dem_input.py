@@ -142,8 +142,11 @@ def input_lines(scene: Scene, data_file: Path, skin: float | None = None) -> lis
     index = material_index(scene)
     for k, w in enumerate(scene.walls):
         kind, (position,) = face_primitive(w.plane, scene.domain.box)
+        # with enduring conduction heat/gran conducts from a wall at a temperature too (its share
+        # during each collision is taken back, as for pairs)
+        hot = f" temperature {num(w.temperature)}" if scene.effects.enduring_conduction and w.temperature > 0 else ""
         lines.append(f"fix wall{k} all wall/gran model hertz tangential history primitive "
-                     f"type {index[w.material] + 1} {kind} {num(position)}")
+                     f"type {index[w.material] + 1} {kind} {num(position)}{hot}")
     if scene.effects.enduring_conduction:       # LIGGGHTS' own conduction through lasting contacts
         lines += ["fix m5 all property/global thermalConductivity peratomtype " + " ".join(num(m.conductivity) for m in mats),
                   "fix m6 all property/global thermalCapacity peratomtype " + " ".join(num(m.heat_capacity) for m in mats),

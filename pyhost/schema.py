@@ -66,7 +66,8 @@ class Effects:
     heat_path: str = spec("in:exact,fast", "fast", "plugin evaluation path")
     restitution_feedback: bool = spec(default=False, doc="apply the model's e(v0) at contact end")
     enduring_conduction: bool = spec(default=False, doc="box scenes: LIGGGHTS' fix heat/gran conducts through "
-                                                         "particle contacts that outlast a collision")
+                                                         "particle contacts that outlast a collision, and those "
+                                                         "with walls at a temperature")
     wall_heat: bool = spec(default=True, doc="collisions with walls at a fixed temperature exchange heat")
     convection: str = spec("in:none," + ",".join(sorted(CORRELATIONS)), "none",
                            "gas-particle convection: Nusselt correlation (plugins.convection); turns on the "
