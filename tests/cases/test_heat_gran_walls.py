@@ -1,7 +1,8 @@
 """A script's fix heat/gran conducting from a hot wall, against plain LIGGGHTS: one glass sphere
 dropped 0.1 mm onto a floor at 350 K (a primitive plane, ``fix wall/gran ... temperature 350.``,
-or a mesh of two triangles, ``fix mesh/surface ... temperature 350.``; the sphere lands off
-their common edge; the plane also with the host on two MPI ranks), the
+or a mesh of two triangles, ``fix mesh/surface ... temperature 350.``, the sphere landing
+off their common edge or on it, where LIGGGHTS conducts once; the plane also with the host on
+two MPI ranks), the
 scene's [[walls]] giving the floor the same temperature for the models' collision heat. The
 host takes back what heat/gran conducted through the wall contact during each collision's
 model time t_coll (pyhost.effects.collisions.take_back_heat_gran); LIGGGHTS run alone, its
@@ -41,7 +42,7 @@ pair_coeff * *
 timestep 1e-6
 fix gravi all gravity 9.81 vector 0 0 -1
 {floor}
-create_atoms 1 single 0.006 0.012 0.0011 units box
+create_atoms 1 single {x} {y} 0.0011 units box
 set group all diameter 0.002 density 2500
 fix heattransfer all heat/gran initial_temperature 300.
 fix integr all nve/sphere
@@ -71,8 +72,9 @@ FLOORS = {
 }
 
 
-@pytest.mark.parametrize("floor, ranks", [("primitive", 1), ("mesh", 1), ("primitive", 2)])
-def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(floor, ranks, tmp_path):
+@pytest.mark.parametrize("floor, ranks, at", [("primitive", 1, (0.006, 0.012)), ("mesh", 1, (0.006, 0.012)),
+                                              ("mesh", 1, (0.01, 0.01)), ("primitive", 2, (0.006, 0.012))])
+def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(floor, ranks, at, tmp_path):
     """The sphere's first impact (about 4,500 steps of 1 us down, v0 = 0.044 m/s, t_coll about 10 steps): heat/gran's share
     during t_coll, taken back by the host, equals m c times the sphere's Temp rises in plain
     LIGGGHTS over the contact's first t_coll / dt steps (the last one in part), to 1e-9; the
@@ -80,7 +82,7 @@ def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(flo
     native = tmp_path / "native"
     native.mkdir()
     (native / "floor.stl").write_text(FLOOR_STL)
-    (native / "in.drop").write_text(SCRIPT.format(floor=FLOORS[floor], dump="dump t all custom 1 temp.dump id f_Temp[0]\n"
+    (native / "in.drop").write_text(SCRIPT.format(floor=FLOORS[floor], x=at[0], y=at[1], dump="dump t all custom 1 temp.dump id f_Temp[0]\n"
                                                            'dump_modify t format "%d %.17g"\n'))
     r = subprocess.run(["liggghts", "-in", "in.drop", "-screen", "/dev/null", "-log", "none"], cwd=native,
                        capture_output=True, text=True, timeout=300)
@@ -93,7 +95,7 @@ def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(flo
     case = tmp_path / "host"
     case.mkdir()
     (case / "floor.stl").write_text(FLOOR_STL)
-    (case / "in.drop").write_text(SCRIPT.format(floor=FLOORS[floor], dump=""))
+    (case / "in.drop").write_text(SCRIPT.format(floor=FLOORS[floor], x=at[0], y=at[1], dump=""))
     (case / "case.toml").write_text(SCENE)
     mpirun = ["mpirun", "--oversubscribe", "-np", str(ranks)] if ranks > 1 else []
     r = subprocess.run(mpirun + [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(case / "out")],
