@@ -177,26 +177,47 @@ def test_heat_gran_script_with_sources_restarts_bit_for_bit(tmp_path):
     after the sources were set, and restarted: collisions.csv, history.csv and summary.json
     (heat_from_sources included) equal to the last bit those of the run that wrote its periodic
     checkpoint at that step (0.575 s, the end of the chunk) and went on."""
+    whole = restarts_bit_for_bit(heat_sources_case(tmp_path), ("test_end = 0.55", "test_end = 0.6"), 0.575,
+                                 "checkpoint at t = 0.575 s (step 23000)", 22500)
+    assert whole["heat_from_sources"] != 0.0
+
+
+def restarts_bit_for_bit(case: Path, end: tuple, checkpoint: float, said: str, stop_at: int) -> dict:
+    """``case`` run with --test to its end changed as ``end`` (old, new) and a periodic
+    checkpoint at ``checkpoint`` [s] (which it ``said``), and again stopped by SIGTERM at step
+    ``stop_at`` (checkpointing at the same step) then restarted: collisions.csv, history.csv and
+    summary.json equal to the last bit. Returns the summary."""
     from conftest import STOPPER
 
-    case = heat_sources_case(tmp_path)
-    text = (case / "case.toml").read_text().replace("test_end = 0.55", "test_end = 0.6")
-    (case / "case.toml").write_text(text.replace("[output]\n", "[output]\ncheckpoint = 0.575\n"))
+    text = (case / "case.toml").read_text().replace(*end)
+    (case / "case.toml").write_text(text.replace("[output]\n", f"[output]\ncheckpoint = {checkpoint}\n"))
     r, whole = run(case, "--test")
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-    assert "checkpoint at t = 0.575 s (step 23000)" in r.stdout
-    cut = tmp_path / "cut"
-    stopped = subprocess.run([sys.executable, "-c", STOPPER, "22500", "SIGTERM", "run", str(case), "--test",
+    assert said in r.stdout
+    cut = case.parent / "cut"
+    stopped = subprocess.run([sys.executable, "-c", STOPPER, str(stop_at), "SIGTERM", "run", str(case), "--test",
                               "--out", str(cut)], capture_output=True, text=True, cwd=ROOT, timeout=900)
     assert stopped.returncode == 128 + 15, stopped.stdout[-3000:] + stopped.stderr[-3000:]
-    assert "checkpoint at t = 0.575 s (step 23000)" in stopped.stdout
+    assert said in stopped.stdout
     again = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--test", "--out", str(cut),
                             "--restart"], capture_output=True, text=True, cwd=ROOT, timeout=900)
     assert again.returncode == 0, again.stdout[-3000:] + again.stderr[-3000:]
     for name in ("collisions.csv", "history.csv"):
         assert (cut / name).read_bytes() == (case / "out" / name).read_bytes(), name
-    restarted = json.loads((cut / "summary.json").read_text())
-    assert restarted == whole and whole["heat_from_sources"] != 0.0
+    assert json.loads((cut / "summary.json").read_text()) == whole
+    return whole
+
+
+@pytest.mark.skipif(not TUTORIAL.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
+def test_hot_script_wall_take_back_restarts_bit_for_bit(tmp_path):
+    """heatTransfer_1 with its 1000 K floor in the script and in [[walls]] (heat/gran's share of
+    each wall collision taken back) stopped by SIGTERM after the half bed's Temp set and
+    restarted: collisions.csv, history.csv and summary.json (heat_gran_walls_undone included)
+    equal to the last bit those of the run that wrote its periodic checkpoint at that step."""
+    case = hot_floor_case(tmp_path, '[[walls]]\nfix = "zwalls1"\nmaterial = "steel"\ntemperature = 1000.0\n')
+    whole = restarts_bit_for_bit(case, ("test_end = 0.52", "test_end = 0.53"), 0.51,
+                                 "checkpoint at t = 0.51 s (step 20400)", 20200)
+    assert whole["heat_gran_walls_undone"] > 0.0
 
 
 @pytest.mark.skipif(not STREAM.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
