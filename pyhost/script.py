@@ -343,21 +343,14 @@ class ScriptInfo:
             return None
         return wall.type if wall.primitive is not None else self.mesh_types.get(wall.meshes[mesh])
 
-    def conducting_temperature(self, fix: str, mesh: int = 0) -> float | None:
-        """The temperature [K] through which the script's fix heat/gran conducts into the
-        contacts of a wall fix's primitive, or of its mesh number ``mesh``; None: none (or no
-        heat/gran). ScriptError if the script gives it otherwise than as a number."""
+    def conducting_temperature(self, fix: str, mesh: int = 0) -> str | None:
+        """The temperature, as written (a number or a $variable: the engine evaluates it), at
+        which the script's fix heat/gran conducts into the contacts of a wall fix's primitive,
+        or of its mesh number ``mesh``; None: none (or no heat/gran)."""
         wall = self.walls.get(fix)
         if wall is None or self.heat_gran is None:
             return None
-        word = wall.temperature if wall.primitive is not None else self.mesh_temperatures.get(wall.meshes[mesh])
-        if word is None:
-            return None
-        try:
-            return float(word)
-        except ValueError:
-            raise ScriptError(f"wall {fix}: its temperature {word!r} for heat/gran: the host needs it as a number "
-                              "(to give its collisions heat at it)") from None
+        return wall.temperature if wall.primitive is not None else self.mesh_temperatures.get(wall.meshes[mesh])
 
     def wall_temperatures(self, fix: str) -> list[str]:
         """The temperatures a wall fix's primitive, or its meshes, have in the script (as

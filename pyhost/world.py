@@ -205,15 +205,15 @@ def user_script(scene):
                 raise SceneError(f"{scene.path}: walls[{k}].fix: the script has no fix wall/gran {w.fix!r} "
                                  f"before its first run; its walls: {', '.join(known) or 'none'}")
             for mesh in range(max(len(known[w.fix].meshes), 1)):
-                T = info.conducting_temperature(w.fix, mesh)       # the script's, at which its heat/gran conducts
-                if T is not None and w.temperature > 0 and T != w.temperature:
+                word = info.conducting_temperature(w.fix, mesh)    # the script's, at which its heat/gran conducts
+                if word is not None and w.temperature > 0 and dem.value(word) != w.temperature:
                     raise SceneError(f"{scene.path}: walls[{k}].temperature: {w.temperature:g} K, where the script "
-                                     f"gives wall {w.fix!r} {T:g} K (its fix heat/gran conducts at it): one wall, one "
-                                     "temperature")
+                                     f"gives wall {w.fix!r} {dem.value(word):g} K (its fix heat/gran conducts at it): "
+                                     "one wall, one temperature")
                 named[w.fix, mesh] = (materials.index(w.material), w.temperature if w.temperature > 0 else np.nan)
-                if T is not None and w.temperature == 0 and (w.fix, mesh) not in told:
+                if word is not None and w.temperature == 0 and (w.fix, mesh) not in told:
                     print(f"LIGGGHTS wall {w.fix!r}: adiabatic for collision heat, though the script's fix heat/gran "
-                          f"conducts through it at {T:g} K: give its [[walls]] entry temperature = {T:g} for the "
+                          f"conducts through it at {word} K: give its [[walls]] entry that temperature for the "
                           "models' collision heat")
         for fix in known:
             if fix not in {f for f, _ in named} and fix not in told:

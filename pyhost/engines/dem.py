@@ -155,20 +155,33 @@ class Dem:
                 self.log(f"LIGGGHTS {line}{where}; each warning is shown once, all are in {self.lmp.log}")
 
     @collective
+    def value(self, text: str) -> float:
+        """A number of the script as LIGGGHTS evaluates it (a plain number or a $variable);
+        ScriptError with LIGGGHTS' message if it cannot."""
+        try:
+            return float(text)
+        except ValueError:
+            pass
+        try:
+            self._raw(f"variable collheat_value equal {text}")
+            # evaluated inside a tried command, so that a bad expression (run ${word}) is an
+            # error naming the script's line, not the end of the process
+            self._raw("variable collheat_checked equal ${collheat_value}")
+        except LiggghtsError as exc:
+            raise ScriptError(str(exc)) from None
+        self._order("variable", "collheat_value")
+        return self.lmp.variable("collheat_value")
+
+    @collective
     def steps(self, steps: str, upto: bool) -> int:
         """The number of steps of a ``run`` (a number or a $variable, evaluated by LIGGGHTS)."""
         try:
             value = float(int(steps))
         except ValueError:
             try:
-                self._raw(f"variable collheat_steps equal {steps}")
-                # evaluated inside a tried command, so that a bad expression (run ${word}) is an
-                # error naming the script's line, not the end of the process
-                self._raw("variable collheat_checked equal ${collheat_steps}")
-            except LiggghtsError as exc:
+                value = self.value(steps)
+            except ScriptError as exc:
                 raise ScriptError(f"run {steps}: {exc}") from None
-            self._order("variable", "collheat_steps")
-            value = self.lmp.variable("collheat_steps")
         # LIGGGHTS' own rules for 'run N [upto]' (its run.cpp): a whole N, 0 <= N < 2^31, and an
         # upto step not before the current one
         if value != int(value):
@@ -470,7 +483,8 @@ class Dem:
                               (True, [(fix, k) for fix, w in self.info.walls.items() for k in range(len(w.meshes or ()))])):
             params = []
             for fix, k in walls:
-                T = self.info.conducting_temperature(fix, k) if (fix, k) in heated else None
+                word = self.info.conducting_temperature(fix, k) if (fix, k) in heated else None
+                T = None if word is None else self.value(word)
                 mode, area = self.info.walls[fix].contact_area
                 params.append((-1.0 if T is None else T, self.info.wall_type(fix, k) or 0,
                                ("overlap", "constant", "projection").index(mode) if mode in ("constant", "projection")

@@ -55,6 +55,9 @@ class DemEngine(Protocol):
     def steps(self, steps: str, upto: bool) -> int:
         """The number of steps of a script's ``run N [upto]``."""
 
+    def value(self, text: str) -> float:
+        """A number of the script as the engine evaluates it (a plain number or a $variable)."""
+
     def run(self, steps: int) -> None:
         """Advance ``steps`` steps (0: set up only)."""
 
