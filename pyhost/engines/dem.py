@@ -488,7 +488,7 @@ class Dem:
                 mode, area = self.info.walls[fix].contact_area
                 params.append((-1.0 if T is None else T, self.info.wall_type(fix, k) or 0,
                                ("overlap", "constant", "projection").index(mode) if mode in ("constant", "projection")
-                               else 0, float(area) if mode == "constant" else 0.0))
+                               else 0, self.value(area) if mode == "constant" and T is not None else 0.0))
                 if T is not None:
                     conducting.add(WALL_BASE + wall_index[fix, k])
             if not self.events.wall_conduction(meshes, params):
