@@ -2,7 +2,8 @@
 dropped 0.1 mm onto a floor at 350 K (a primitive plane, ``fix wall/gran ... temperature 350.``,
 or a mesh of two triangles, ``fix mesh/surface ... temperature 350.``, the sphere landing
 off their common edge or on it, where LIGGGHTS conducts once; the plane also with the host on
-two MPI ranks, and with its temperature a variable, which LIGGGHTS evaluates), the
+two MPI ranks, with its temperature a variable, which LIGGGHTS evaluates, and with a constant contact
+area), the
 scene's [[walls]] giving the floor the same temperature for the models' collision heat. The
 host takes back what heat/gran conducted through the wall contact during each collision's
 model time t_coll (pyhost.effects.collisions.take_back_heat_gran); LIGGGHTS run alone, its
@@ -69,6 +70,8 @@ FLOORS = {
     "primitive": "fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0 temperature 350.",
     "primitive, ${Tw}": "variable Tw equal 300+50\n"
                         "fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0 temperature ${Tw}",
+    "primitive, constant area": "fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0 "
+                                "temperature 350. contact_area constant 2e-8",
     "mesh": "fix plate all mesh/surface file floor.stl type 1 move 0.01 0.01 0. temperature 350.\n"
             "fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes plate",
 }
@@ -76,7 +79,8 @@ FLOORS = {
 
 @pytest.mark.parametrize("floor, ranks, at", [("primitive", 1, (0.006, 0.012)), ("mesh", 1, (0.006, 0.012)),
                                               ("mesh", 1, (0.01, 0.01)), ("primitive", 2, (0.006, 0.012)),
-                                              ("primitive, ${Tw}", 1, (0.006, 0.012))])
+                                              ("primitive, ${Tw}", 1, (0.006, 0.012)),
+                                              ("primitive, constant area", 1, (0.006, 0.012))])
 def test_heat_grans_share_during_a_wall_collision_is_what_liggghts_conducted(floor, ranks, at, tmp_path):
     """The sphere's first impact (about 4,500 steps of 1 us down, v0 = 0.044 m/s, t_coll about 10 steps): heat/gran's share
     during t_coll, taken back by the host, equals m c times the sphere's Temp rises in plain
