@@ -298,11 +298,11 @@ def read_script(path, variables: dict | None = None) -> Script:
         if "$" not in line or not _read_by_post(line.split()):
             continue
         bad = sorted(_references(line) - same)
+        reasons = [f"{n}: {why_not.get(n, 'not defined (give --var ' + n + ' VALUE)')}" for n in bad]
         if '"' in line or "$(" in line:
-            bad = bad or ["a quoted text or $(...)"]
-        if bad:
-            reasons = "; ".join(f"{n}: {why_not.get(n, 'not defined (give --var ' + n + ' VALUE)')}" for n in bad)
-            warnings.append(f"{path}: line {number}: post cannot substitute its variables ({reasons})")
+            reasons.append("a quoted text or an immediate $(...)")
+        if reasons:
+            warnings.append(f"{path}: line {number}: post cannot substitute its variables ({'; '.join(reasons)})")
         else:
             asked.append((number, line))
     literal = all(_is_number(line.split()[1:2]) for _, line in setup if line.split()[0] == "timestep")
