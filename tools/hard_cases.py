@@ -89,6 +89,11 @@ BOX_CASES = {   # name: scene
                                                    "effects.restitution_feedback": True}),
     "model C, exact path, spread 10 m/s": hot_cold_box(
         **both_groups("velocity_spread", 10.0), **{"effects.contact_heat": "C", "effects.heat_path": "exact"}),
+    "walls at 1500 K and 100 K, enduring conduction, spread 10 m/s": hot_cold_box(
+        **both_groups("velocity_spread", 10.0), **{"effects.enduring_conduction": True,
+                                                   "domain.periodic": [True, True, False],
+                                                   "walls": [dict(plane="zlo", material="steel", temperature=1500.0),
+                                                             dict(plane="zhi", material="steel", temperature=100.0)]}),
 }
 
 
