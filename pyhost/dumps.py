@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.script import Command, ScriptError, ScriptInfo
+from pyhost.script import Command, ScriptError, ScriptInfo, script_commands
 from pyhost.walls import PRIMITIVES
 
 
@@ -251,21 +251,6 @@ def local_compute(path) -> str:
     return head[8].split()[2].split("[")[0][2:]
 
 
-def _joined(text: str):
-    """(number of its first line, text) of each command of a script, '&' continuations joined."""
-    pending, first = "", 1
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not pending:
-            first = number
-        if re.search(r"&[ \t]*$", line):
-            pending += re.sub(r"&[ \t]*$", " ", line)
-            continue
-        yield first, pending + line
-        pending = ""
-    if pending:
-        yield first, pending
-
-
 def _is_number(words: list[str]) -> bool:
     try:
         float(words[0])
@@ -277,19 +262,17 @@ def _is_number(words: list[str]) -> bool:
 def read_script(path, variables: dict | None = None) -> Script:
     """Reads ``timestep``, the local computes and the mesh wall fixes of a LIGGGHTS input, its
     property/globals, wall types, and the steps at which it sets particles' Temp (counted
-    through its ``run N [upto]`` and ``reset_timestep``) (``&`` continuations and ``#``
-    comments handled; ``include`` is not followed). ``$`` variables in those commands are
+    through its ``run N [upto]`` and ``reset_timestep``), read as the run reads it
+    (``pyhost.script.script_commands``: ``&`` continuations, ``#`` comments, included files
+    in their place, relative to the script's folder). ``$`` variables in those commands are
     substituted by LIGGGHTS at their place in the script's set-up (``resolve_setup``), with
     ``variables`` as LIGGGHTS' command line ``-var`` gives them, where post's set-up gives them
     the run's values (``setup_variables``); a command whose variables it cannot substitute keeps
     them, and a warning says why."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read the LIGGGHTS script: {exc.strerror}") from None
-    commands = [(number, " ".join(line.split("#")[0].split())) for number, line in _joined(text)]
-    commands = [(number, line) for number, line in commands if line]
+    read = script_commands(path)
+    commands = list(enumerate(c.text for c in read))        # (place in the script, text)
+    where_of = [f"{c.file}: line {c.line}" for c in read]
     variables = {str(k): str(v) for k, v in (variables or {}).items()}
     setup = [(number, line) for number, line in commands if line.split()[0] in SETUP_COMMANDS]
     same, why_not = setup_variables(setup, variables)
@@ -302,7 +285,7 @@ def read_script(path, variables: dict | None = None) -> Script:
         if '"' in line or "$(" in line:
             reasons.append("a quoted text or an immediate $(...)")
         if reasons:
-            warnings.append(f"{path}: line {number}: post cannot substitute its variables ({'; '.join(reasons)})")
+            warnings.append(f"{where_of[number]}: post cannot substitute its variables ({'; '.join(reasons)})")
         else:
             asked.append((number, line))
     literal = all(_is_number(line.split()[1:2]) for _, line in setup if line.split()[0] == "timestep")
@@ -327,9 +310,9 @@ def read_script(path, variables: dict | None = None) -> Script:
     for number, line in commands:
         line = substituted.get(number, line)
         words = line.split()
-        where = f"{path}: line {number}: "
+        where = f"{where_of[number]}: "
         try:
-            info.learn(Command(line, str(path), number))
+            info.learn(Command(line, read[number].file, read[number].line))
         except (ScriptError, ValueError):
             pass                        # a wall the run would refuse: post places none
         if words[0] == "timestep" and len(words) > 1:
@@ -354,8 +337,6 @@ def read_script(path, variables: dict | None = None) -> Script:
             computes[c.id] = c
         elif words[0] == "fix" and len(words) > 3 and words[3] == "wall/gran" and "mesh" in words:
             walls.append(words[1])
-        elif words[0] == "include":
-            warnings.append(f"{where}include {' '.join(words[1:])} not followed")
         elif words[0] in ("run", "reset_timestep", "read_restart"):
             n = int(words[1]) if len(words) > 1 and words[1].isdigit() and words[0] != "read_restart" else None
             step = (None if n is None else n if words[0] == "reset_timestep" or "upto" in words[2:]

@@ -60,9 +60,12 @@ def _strip_comment(line: str) -> str:
     return line
 
 
-def read_script(path: str | Path, folder: str | Path | None = None, _depth: int = 0) -> list[Command]:
-    """The commands of a LIGGGHTS script (see the module doc). ``folder``: where relative
-    include paths are found (the case folder; default the script's own folder)."""
+def script_commands(path: str | Path, folder: str | Path | None = None, _depth: int = 0) -> list[Command]:
+    """The commands of a LIGGGHTS script as LIGGGHTS reads them: '#' comments (outside quotes)
+    dropped, '&' continuations joined, included files read in their place; each with its file
+    and first line. ``folder``: where relative include paths are found (default the script's
+    own folder). ScriptError for a file that is missing or not text, an include nested more
+    than 20 deep or of a variable file name, or a script ending inside a continuation."""
     path = Path(path)
     folder = Path(folder) if folder is not None else path.parent
     if _depth > 20:
@@ -86,6 +89,25 @@ def read_script(path: str | Path, folder: str | Path | None = None, _depth: int 
         if not text:
             continue
         cmd = Command(" ".join(text.split()) if '"' not in text and "'" not in text else text, str(path), first)
+        if cmd.name == "include":
+            words = cmd.words
+            if len(words) != 2:
+                raise ScriptError(f"{cmd.where()}: include takes one file name")
+            if "$" in words[1]:
+                raise ScriptError(f"{cmd.where()}: include of a variable file name is not supported")
+            commands += script_commands(folder / words[1], folder, _depth + 1)
+            continue
+        commands.append(cmd)
+    if pending:
+        raise ScriptError(f"{path}:{first}: the script ends inside a '&' continuation")
+    return commands
+
+
+def read_script(path: str | Path, folder: str | Path | None = None) -> list[Command]:
+    """The commands of a LIGGGHTS script the host runs (``script_commands``), with what the
+    host cannot run refused before any engine time (see the module doc)."""
+    commands = script_commands(path, folder)
+    for cmd in commands:
         if cmd.name in REFUSED:
             raise ScriptError(f"{cmd.where()}: '{cmd.name}': {REFUSED[cmd.name]}; the host runs a script "
                               "command by command (unroll the loop, or give the values as variables)")
@@ -103,17 +125,6 @@ def read_script(path: str | Path, folder: str | Path | None = None, _depth: int 
                               "sphere of its own mass, and a clump's spheres carry the whole clump's")
         if cmd.name == "run":
             parse_run(cmd)              # 'run ... every' and other forms refused before any engine time
-        if cmd.name == "include":
-            words = cmd.words
-            if len(words) != 2:
-                raise ScriptError(f"{cmd.where()}: include takes one file name")
-            if "$" in words[1]:
-                raise ScriptError(f"{cmd.where()}: include of a variable file name is not supported")
-            commands += read_script(folder / words[1], folder, _depth + 1)
-            continue
-        commands.append(cmd)
-    if pending:
-        raise ScriptError(f"{path}:{first}: the script ends inside a '&' continuation")
     return commands
 
 

@@ -310,3 +310,17 @@ def test_which_variables_posts_set_up_evaluates_as_the_run_does():
     assert same == {"alphastart", "growts", "Rgrowrate", "top", "n", "label", "late", "fromcli"}
     assert why == {"nat": "its formula names all, count", "t": "its formula names dt, step", "d": "it is atom-style",
                    "twice": "it names nat", "gone": "it names nowhere (not defined)"}
+
+
+def test_an_included_file_is_read_in_its_place(tmp_path):
+    """post reads a script as the run does (pyhost.script.script_commands): an included file's
+    commands in their place, named by their own file and line; before, post warned 'include
+    ... not followed' and missed the included property/globals and runs."""
+    (tmp_path / "in.materials").write_text("fix m1 all property/global youngsModulus peratomtype 5e6\n"
+                                           "run 300\n")
+    (tmp_path / "in.main").write_text("timestep 1e-5\ninclude in.materials\nrun 200\n"
+                                      "set type 1 property/atom Temp 350\n")
+    script = read_script(tmp_path / "in.main")
+    assert script.globals == {"youngsModulus": (f"{tmp_path / 'in.materials'}: line 1", ["peratomtype", "5e6"])}
+    assert [(step, where) for step, where, _ in script.temperature_sets] == [(500, f"{tmp_path / 'in.main'}: line 4")]
+    assert script.warnings == ()
