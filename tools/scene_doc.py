@@ -26,7 +26,9 @@ SECTIONS = (
                                             "(a script sets its own)."),
     ("[[particles]]", S.Particles, "Box scenes: a group of particles the host places."),
     ("[[walls]]", S.Wall, "A wall's real material and temperature: by plane (box scenes) or by the id of "
-                          "the script's fix wall/gran (script scenes). A script wall with no entry is adiabatic."),
+                          "the script's fix wall/gran (script scenes). A script wall with no entry is adiabatic for "
+                          "collision heat (a fix heat/gran of the script still conducts through it at the temperature "
+                          "the script gives it)."),
     ("[domain]", S.Domain, "Box scenes: the box."),
     ("[time]", S.Time, "Time steps, fluid coupling and harvests."),
     ("[fluid]", S.Fluid, "The gas, solved by collheatFoam."),
