@@ -280,8 +280,7 @@ def _keyword(words: list[str], name: str) -> str | None:
 def _contact_area(words: list[str]) -> tuple:
     """A fix wall/gran's ``contact_area`` (its heat conduction's): (mode, constant area as written)."""
     mode = _keyword(words, "contact_area") or "overlap"
-    at = [k for k in range(4, len(words) - 2) if words[k] == "contact_area"]
-    return (mode, words[at[-1] + 2] if mode == "constant" and at else None)
+    return (mode, _keyword(words, "constant") if mode == "constant" else None)
 
 
 @dataclass(frozen=True)

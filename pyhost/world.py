@@ -206,9 +206,10 @@ def user_script(scene):
                                  f"before its first run; its walls: {', '.join(known) or 'none'}")
             for mesh in range(max(len(known[w.fix].meshes), 1)):
                 word = info.conducting_temperature(w.fix, mesh)    # the script's, at which its heat/gran conducts
-                if word is not None and w.temperature > 0 and dem.value(word) != w.temperature:
+                T = dem.value(word) if word is not None and w.temperature > 0 else None
+                if T is not None and T != w.temperature:
                     raise SceneError(f"{scene.path}: walls[{k}].temperature: {w.temperature:g} K, where the script "
-                                     f"gives wall {w.fix!r} {dem.value(word):g} K (its fix heat/gran conducts at it): "
+                                     f"gives wall {w.fix!r} {T:g} K (its fix heat/gran conducts at it): "
                                      "one wall, one temperature")
                 named[w.fix, mesh] = (materials.index(w.material), w.temperature if w.temperature > 0 else np.nan)
                 if word is not None and w.temperature == 0 and (w.fix, mesh) not in told:
