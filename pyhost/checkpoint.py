@@ -99,7 +99,7 @@ def write(coupling) -> Path:
     if final.exists():
         final.rename(old)
     new.rename(final)
-    coupling.checkpoint_step = dem.step
+    coupling.checkpoint_step = coupling.steps
     shutil.rmtree(old, ignore_errors=True)
     size = sum(p.stat().st_size for p in final.rglob("*") if p.is_file())     # the fluid's fields included
     print(f"checkpoint at t = {coupling.t:.6g} s (step {dem.step}): {final}, {size / 1e6:.3g} MB, "

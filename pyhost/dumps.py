@@ -30,7 +30,7 @@ import gzip
 import re
 import shlex
 import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import islice
 from pathlib import Path
 
@@ -119,6 +119,53 @@ def parse_compute(text: str, where: str = "") -> Compute:
 
 
 @dataclass(frozen=True)
+class Clock:
+    """The time of a script's steps across its runs, as LIGGGHTS steps them: each run's
+    (first step, last step, time step [s], time at its first step [s]) in script order, a
+    ``reset_timestep`` numbering the next run's steps anew and a ``timestep`` changing its dt.
+    A frame's ``count`` is its step counted through the runs (never going back), from which
+    ``time`` gives the time [s]. ``steady(dt)``: one run from step 0 at dt, without end."""
+
+    runs: tuple
+
+    @staticmethod
+    def steady(dt: float) -> "Clock":
+        return Clock(((0, float("inf"), dt, 0.0),))
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """The count at each run's first step."""
+        return np.cumsum([0] + [last - first for first, last, _, _ in self.runs[:-1]])
+
+    def time(self, count) -> np.ndarray | float:
+        """The time [s] of a step's count (scalar or array); beyond the last run, at its dt."""
+        offsets, count = self.offsets, np.asarray(count)
+        r = np.maximum(np.searchsorted(offsets, count, side="right") - 1, 0)
+        t0, dt = np.array([run[3] for run in self.runs]), np.array([run[2] for run in self.runs])
+        t = t0[r] + (count - offsets[r]) * dt[r]
+        return float(t) if t.ndim == 0 else t
+
+    def counter(self):
+        """``place(step)`` for the frames of one dump stream in their order: the step's count, the
+        frame's run being the same as the last frame's or a later one (after a reset_timestep,
+        one whose steps go back to it); None for a step no run from there holds."""
+        offsets = self.offsets
+        at = [0, None]                              # the run of the last frame, its step
+
+        def place(step: int):
+            r, last = at
+            while r < len(self.runs):
+                first, end = self.runs[r][:2]
+                if first <= step <= end and (last is None or step >= last):
+                    at[:] = r, step
+                    return int(offsets[r] + step - first)
+                r, last = r + 1, None
+            return None
+
+        return place
+
+
+@dataclass(frozen=True)
 class Script:
     """What post-processing needs from the LIGGGHTS input that wrote the dumps."""
 
@@ -131,7 +178,8 @@ class Script:
     primitives: dict = field(default_factory=dict)  # primitive wall fix id -> (kind, numbers) (pyhost.walls)
     globals: dict = field(default_factory=dict)     # property/global name -> (where, words after the name)
     wall_types: dict = field(default_factory=dict)  # wall/gran fix id -> atom type of its primitive or first mesh
-    temperature_sets: tuple = ()    # (step or None if unknown, where, command) of each 'set ... property/atom Temp'
+    temperature_sets: tuple = ()    # (count or None if unknown, where, command) of each 'set ... property/atom Temp'
+    clock: Clock | None = None      # its runs' steps and times (None: a run's steps or its first step unknown)
 
 
 SETUP_COMMANDS = ("units", "dimension", "boundary", "atom_style", "atom_modify", "newton", "communicate",
@@ -157,8 +205,8 @@ def _references(text: str) -> set[str]:
 def _read_by_post(words: list[str]) -> bool:
     """Whether post reads this command's values, whose ``$`` variables it then has LIGGGHTS
     substitute at their place in the set-up: a fix property/global, a primitive wall, a run
-    or reset_timestep, a set of Temp."""
-    return (words[0] in ("run", "reset_timestep")
+    or reset_timestep, a timestep, a set of Temp."""
+    return (words[0] in ("run", "reset_timestep", "timestep")
             or words[0] == "fix" and len(words) > 3 and (words[3] == "property/global"
                                                          or words[3] == "wall/gran" and "primitive" in words)
             or words[0] == "set" and "property/atom" in words and "Temp" in words)
@@ -307,6 +355,7 @@ def read_script(path, variables: dict | None = None) -> Script:
     heat_gran, primitives = [], {}
     globals_, info = {}, ScriptInfo()      # info: the walls and their atom types, as a run learns them
     step, temperature_sets, ran = 0, [], False    # the step reached (None: unknown, a $variable); any run yet
+    runs, count, t = [], 0, 0.0     # the clock's runs so far, the steps counted through them, the time [s]
     for number, line in commands:
         line = substituted.get(number, line)
         words = line.split()
@@ -339,15 +388,25 @@ def read_script(path, variables: dict | None = None) -> Script:
             walls.append(words[1])
         elif words[0] in ("run", "reset_timestep", "read_restart"):
             n = int(words[1]) if len(words) > 1 and words[1].isdigit() and words[0] != "read_restart" else None
+            first = step
             step = (None if n is None else n if words[0] == "reset_timestep" or "upto" in words[2:]
                     else None if step is None else step + n)
+            if words[0] == "run" and runs is not None:
+                if first is None or step is None or timestep is None:
+                    runs = None         # (a read_restart's step, a run of $variable steps: no clock)
+                elif step > first:
+                    runs.append((first, step, timestep, t))
+                    count, t = count + step - first, t + (step - first) * timestep
             ran = ran or words[0] == "run"
         elif (words[0] == "set" and ran and "property/atom" in words[:-2]
               and words[words.index("property/atom") + 1] == "Temp"):     # (before any run: the first frame's)
-            temperature_sets.append((step, where.rstrip(": "), " ".join(words)))
+            temperature_sets.append(((count, step), where.rstrip(": "), " ".join(words)))
     wall_types = {fix: info.wall_type(fix) for fix in info.walls if info.wall_type(fix) is not None}
+    clock = Clock(tuple(runs)) if runs else None
+    # each set at its step counted through the runs; without a clock, at its step (as a steady clock counts)
+    temperature_sets = [((count if clock else step), where, cmd) for (count, step), where, cmd in temperature_sets]
     return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), primitives, globals_,
-                  wall_types, tuple(temperature_sets))
+                  wall_types, tuple(temperature_sets), clock)
 
 
 @dataclass(frozen=True, eq=False)
@@ -356,14 +415,15 @@ class Frame:
 
     file: str
     line: int                       # line of its ITEM: TIMESTEP (0 for VTK)
-    step: int
-    time: float | None              # step * dt [s], None without dt
+    step: int                       # its step counted through the script's runs (``Clock``; the file's without one)
+    time: float | None              # [s] (``Clock.time``), None without a clock or dt
     box: np.ndarray | None          # (3, 2) lo hi [m]; None for VTK (no box in the file)
     periodic: tuple                 # (bool, bool, bool)
     columns: tuple
     data: np.ndarray
     kind: str = "atoms"             # atoms, pair, wall, local
     groups: dict = field(default_factory=dict)     # name -> column indices of a group (local)
+    timestep: int | None = None     # the step as the file numbers it (None: ``step``)
 
     def __len__(self) -> int:
         return len(self.data)
@@ -491,14 +551,16 @@ def _vtk_step(path: Path) -> int:
 class DumpReader:
     """Frames of dump files in timestep order: ``for frame in DumpReader(paths): ...``.
 
-    ``computes``: id -> Compute for local dumps (``read_script(...).computes``); ``dt`` [s]
-    gives each frame its time; ``require``: names of ``REQUIRED`` an atom frame must hold;
+    ``computes``: id -> Compute for local dumps (``read_script(...).computes``); ``clock`` (the
+    script's ``Clock``, through its time step changes and resets) or else ``dt`` [s] gives each
+    frame its time and its step counted through the runs; ``require``: names of ``REQUIRED`` an atom frame must hold;
     ``skip_bad_frames``: warn (``self.warnings``) and go on instead of raising.
     """
 
     def __init__(self, paths, computes: dict | None = None, dt: float | None = None, require=(),
-                 skip_bad_frames: bool = False):
-        self.computes, self.dt, self.require = dict(computes or {}), dt, tuple(require)
+                 skip_bad_frames: bool = False, clock: Clock | None = None):
+        self.computes, self.require = dict(computes or {}), tuple(require)
+        self.clock = clock if clock is not None else Clock.steady(dt) if dt is not None else None
         self.skip, self.warnings = skip_bad_frames, []
         files = expand(paths)
         boxes = [p for p in files if p.suffix.lower() in VTK_SUFFIXES and "_boundingBox_" in p.name]
@@ -540,20 +602,26 @@ class DumpReader:
         return [p for _, _, p in sorted(keyed)]
 
     def __iter__(self):
-        last = None                                     # (step, file) of the previous frame
+        last = None                                     # (count, file, step) of the previous frame
+        place = self.clock.counter() if self.clock is not None else None
         for path in self.files:
             frames = self._vtk(path) if path.suffix.lower() in VTK_SUFFIXES else self._text(path)
             for frame in frames:
-                if last is not None and frame.step < last[0]:
+                count = frame.step if place is None else place(frame.step)
+                if count is None or last is not None and count < last[0]:
+                    resets = self.clock is not None and len(self.clock.runs) > 1
                     self._fail(DumpError(frame.file, frame.step, frame.line,
-                                         f"timestep goes backwards (previous frame: timestep {last[0]} in {last[1]})"))
+                                         f"timestep goes backwards (previous frame: timestep {last[2]} in {last[1]})"
+                                         + ("" if resets else ": a script's reset_timestep is followed with --script")
+                                         if last is not None else "timestep before the script's first run"))
                     continue
-                if last is not None and frame.step == last[0]:
+                if last is not None and count == last[0]:
                     self.warnings.append(f"{frame.file}: line {frame.line}: timestep {frame.step} again: "
                                          "frame skipped")
                     continue
-                last = (frame.step, frame.file)
-                yield frame
+                last = (count, frame.file, frame.step)
+                yield replace(frame, step=count, timestep=frame.step,
+                              time=None if self.clock is None else self.clock.time(count))
 
     def _text(self, path: Path):
         try:
@@ -654,9 +722,8 @@ class DumpReader:
             self._check_atoms(data, columns, lambda problem, row: error(problem, first + row))
         elif groups:
             self._check_local(data, columns, groups, lambda problem, row: error(problem, first + row))
-        time = None if self.dt is None else step * self.dt
         periodic = tuple(b == "pp" for b in bounds)
-        return Frame(str(path), start, step, time, box, periodic, tuple(columns), data, kind, groups)
+        return Frame(str(path), start, step, None, box, periodic, tuple(columns), data, kind, groups)
 
     @staticmethod
     def _integer(lines, error, what) -> int:
@@ -778,8 +845,7 @@ class DumpReader:
         except DumpError as exc:
             self._fail(exc)
             return
-        time = None if self.dt is None else step * self.dt
-        yield Frame(str(path), 0, step, time, None, (False, False, False), tuple(columns), data)
+        yield Frame(str(path), 0, step, None, None, (False, False, False), tuple(columns), data)
 
 
 class _HeaderInRows(Exception):

@@ -113,9 +113,11 @@ class Coupling:
         self.keep_all = known.group if known.by == "id" else None   # box scenes: losing any particle fails
         self.before = None               # box scenes: (time, step, particles) before the chunk under way
         self.capacity = np.array([m.heat_capacity for m in self.materials])
-        self.t0_step = dem.step
-        self.t = dem.step * dem.dt
-        self.steps = 0
+        self.clock = (0.0, 0, dem.dt)      # (t, step, dt): the time of LIGGGHTS' step s is t + (s - step) dt
+        self.t = self.time_of(dem.step)     # the simulated time [s]: each step's time step summed
+        self.t_step = dem.step              # the step LIGGGHTS numbers at time t
+        self.t_begin = self.t               # the time at the start of the coupled run
+        self.steps = 0                      # the coupled steps so far (whatever LIGGGHTS numbers them)
         self.totals = totals()            # summary.json's, every effect's whether the scene has it or not
         self.warned = set()
         self.heat = self.effects["particle_temperatures"]
@@ -147,7 +149,7 @@ class Coupling:
         self.extend = 0.0                    # run --extend [s] (a checkpoint keeps it)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
         self.resumed = resume is not None    # the next advance continues the checkpoint's run
-        self.checkpoint_step = -1            # the step of the last checkpoint written
+        self.checkpoint_step = -1            # the coupled steps (``steps``) at the last checkpoint written
         if resume is not None:
             self.restore(resume)
 
@@ -199,14 +201,27 @@ class Coupling:
         with signals.deferred():
             self._advance(n)
 
+    def time_of(self, step) -> float:
+        """The simulated time [s] of LIGGGHTS' step number ``step`` of the run under way."""
+        t, at, dt = self.clock
+        return t + (step - at) * dt
+
     def _advance(self, n: int) -> None:
         if self.heat and not self.resumed:  # (a restart continues a run: no script command came in between)
             self.balance.resync()
         self.resumed = False
         self.run_left = n
+        if (self.dem.dt, self.dem.step) != (self.clock[2], self.t_step):
+            # a 'timestep' or 'reset_timestep' since the last run: time goes on from where it was,
+            # at the new step size, whatever LIGGGHTS numbers the steps (its own time, update's
+            # atime, goes back at a reset_timestep and ignores a timestep change)
+            self.clock = (self.t, self.dem.step, self.dem.dt)
+            self.t_step = self.dem.step
         self.every["frame"] = self.frame_every()   # (a script's dumps and time step as they are now)
+        if self.scene.output.checkpoint:
+            self.every["checkpoint"] = round(self.scene.output.checkpoint / self.dem.dt)
         while n > 0:
-            step = self.dem.step - self.t0_step
+            step = self.steps
             chunk = min([n] + [k - step % k for k in self.every.values() if k])
             if self.keep_all is not None and (self.before is None or self.before[1] != self.dem.step):
                 self.before = (self.t, self.dem.step, self.dem.keep_snapshot())
@@ -217,7 +232,7 @@ class Coupling:
             self.run_left = n
             self.steps += chunk
             step += chunk
-            self.t = self.dem.step * self.dem.dt
+            self.t, self.t_step = self.time_of(self.dem.step), self.dem.step
             due = {name: k and step % k == 0 for name, k in self.every.items()}
             if self.collisions is not None:
                 self.collisions.after_chunk(due)
@@ -256,7 +271,7 @@ class Coupling:
         report from each rank's copy of its particles before the chunk (``Dem.keep_snapshot``)."""
         ids, x, v = self.dem.snapshot()
         gone = np.setdiff1d(ids, self.dem.atoms(False).id)
-        raise particles_lost(self.scene, gone, (self.before[0], ids, x, v), self.dem.step * self.dem.dt, self.keep_all)
+        raise particles_lost(self.scene, gone, (self.before[0], ids, x, v), self.time_of(self.dem.step), self.keep_all)
 
     def write_frame(self) -> None:
         for effect in self.effect_list:
@@ -274,7 +289,7 @@ class Coupling:
         effect's."""
         for effect in self.effect_list:    # every frame a log names on disk
             effect.flush()
-        values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, warned=sorted(self.warned),
+        values = dict(clock=self.clock, t_step=self.t_step, t_begin=self.t_begin, steps=self.steps, t=self.t, totals=self.totals, warned=sorted(self.warned),
                       command=self.command, run_left=self.run_left, mesh_motion=self.dem.mesh_motion_times(),
                       randoms=self.dem.random_states())
         arrays, logs = {}, {}
@@ -288,8 +303,9 @@ class Coupling:
 
     def restore(self, state: dict) -> None:
         """Continue from ``state`` (values and arrays of :meth:`state` in one dict)."""
-        for name in ("t0_step", "steps", "t"):
-            setattr(self, name, state[name])
+        self.steps, self.t = state["steps"], state["t"]
+        self.clock = tuple(state["clock"])
+        self.t_step, self.t_begin = state["t_step"], state["t_begin"]
         self.totals = dict(totals(), **state["totals"])    # (a total newer than the checkpoint starts at 0)
         self.warned = set(state["warned"])
         checkpoint.restore_forces(self.dem, state)
@@ -306,7 +322,7 @@ class Coupling:
             if status == "completed":
                 raise
             print(f"warning: the collisions since the last harvest are not in the log ({type(err).__name__}: {err})")
-        if status == "completed" and self.frames.last_step != self.dem.step:
+        if status == "completed" and self.frames.last_step != self.steps:
             self.write_frame()                # the end's state in history.csv and the VTK series
         for effect in self.effect_list:      # (the fluid: its last advance, if it runs beside the DEM)
             try:
@@ -317,7 +333,7 @@ class Coupling:
                 print(f"warning: {type(err).__name__} at the end of a run that stopped: {err}")
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
         self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
-        summary = dict(self.totals, status=status, time=self.t, steps=self.steps, groups=self.frames.group_names)
+        summary = dict(self.totals, status=status, time=self.t, steps=self.steps, step=self.dem.step, groups=self.frames.group_names)
         for effect in self.effect_list:
             effect.finish(summary, status)
         write_atomic(self.out / "summary.json", json.dumps(summary, indent=1))
@@ -431,7 +447,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                 if more:
                     log(f"{cmd.where()}: --extend {extend:g}: {more} steps more than the case asks")
             if max_time is not None:
-                n = min(n, round(max_time / dem.dt) - coupling.steps)
+                n = min(n, round((max_time - (coupling.t - coupling.t_begin)) / dem.dt))
             if n > 0:
                 try:
                     coupling.advance(n)
@@ -443,13 +459,13 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                               f"{commands[last_run].where()}: '{commands[last_run].text}'); give the steps in "
                               f"the script" + (", or the coupled time as [time] end" if fluid is not None else ""))
         if coupling is not None and scene.output.checkpoint:    # a completed run ends in a checkpoint, marked
-            if coupling.checkpoint_step != dem.step:             # so: --extend goes on from there
+            if coupling.checkpoint_step != coupling.steps:       # so: --extend goes on from there
                 coupling.flush_events()
                 checkpoint.write(coupling)
             checkpoint.mark_complete(out)
     except BaseException as exc:          # keep what was computed: summary of the run so far
         if isinstance(exc, signals.Interrupted) and coupling is not None and coupling.ready \
-                and coupling.checkpoint_step != dem.step:   # (not twice at one step)
+                and coupling.checkpoint_step != coupling.steps:   # (not twice at one step)
             try:
                 coupling.flush_events()
                 checkpoint.write(coupling)

@@ -292,7 +292,7 @@ def read_columns(folder: Path) -> dict:
     return out
 
 
-COLLISION_KINDS = dict(time="f8", i="i8", j="i8", wall="i8", v0="f8", Q="f8", e="f8", t_coll="f8", model="str")
+COLLISION_KINDS = dict(time="f8", step="i8", i="i8", j="i8", wall="i8", v0="f8", Q="f8", e="f8", t_coll="f8", model="str")
 """The kind of each collisions column; side columns Q_<model> are f8."""
 
 

@@ -36,7 +36,7 @@ from plugins.heat.exchange import exchange_heat
 from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.contacts import find_contacts
 from pyhost.dem_input import script_dem_contacts
-from pyhost.dumps import DumpError, DumpReader, expand, local_compute
+from pyhost.dumps import Clock, DumpError, DumpReader, expand, local_compute
 from pyhost.outdir import write_atomic
 from pyhost.output import Progress, VtkSeries
 from pyhost.scene import read_toml
@@ -191,9 +191,13 @@ class Post:
         self.contacts, self.script = list(contacts), script
         self.computes = dict(script.computes if script else {}) | dict(computes or {})
         self.models, self.skip = tuple(models), skip_bad_frames
-        self.dt = dt if dt is not None else (script.timestep if script else None)
-        if self.dt is None:
-            raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
+        # the time of each step: the script's runs through their time step changes and resets, or one dt
+        self.clock = script.clock if dt is None and script and script.clock else None
+        if self.clock is None:
+            dt = dt if dt is not None else (script.timestep if script else None)
+            if dt is None:
+                raise ValueError("the time step is unknown: give --dt, or --script with the script's 'timestep'")
+            self.clock = Clock.steady(dt)
         self.warnings = list(script.warnings) if script else []
         if script and script.heat_gran and temperatures == "own":
             self.warnings.append(f"the script conducts heat with fix heat/gran ({', '.join(script.heat_gran)}): post's "
@@ -232,7 +236,7 @@ class Post:
 
     # -- reading ----------------------------------------------------------------------------
     def reader(self, paths, **kw):
-        r = DumpReader(paths, dt=self.dt, skip_bad_frames=self.skip, **kw)
+        r = DumpReader(paths, clock=self.clock, skip_bad_frames=self.skip, **kw)
         self.warnings.extend(r.warnings)
         return r
 
@@ -272,7 +276,7 @@ class Post:
             ids, types = f["id"].astype(np.int64), f["type"].astype(int)
             unknown = sorted(set(types.tolist()) - set(self.scene.types))
             if unknown:
-                raise ValueError(f"{f.file}: timestep {f.step}: atom type {unknown[0]} is in no material of "
+                raise ValueError(f"{f.file}: timestep {f.timestep}: atom type {unknown[0]} is in no material of "
                                  f"{self.scene.path} (materials.NAME.types)")
             column = self.temperature_column(f)
             self.particles.add(ids, types, f["radius"], f[column] if column else None)
@@ -284,8 +288,8 @@ class Post:
                 self.position_contacts(f, ids, walls, found, first, steps)
         self.summary["frames"] = len(steps)
         self.summary["particles"] = len(last) if last is not None else 0
-        self.dump_steps = np.diff(steps).min() if len(steps) > 1 else None
-        self.interval = self.dump_steps
+        # the shortest interval between two frames ([s], steps): what collisions it can miss
+        self.interval = (min(zip(np.diff(self.clock.time(steps)), np.diff(steps))) if len(steps) > 1 else None)
         return found
 
     def temperature_column(self, f) -> str | None:
@@ -316,7 +320,7 @@ class Post:
         if len(steps) == 1:
             self.open_at_start(f, len(keys))
             return
-        window = (steps[-1] - steps[-2]) * self.dt
+        window = self.clock.time(steps[-1]) - self.clock.time(steps[-2])
         found.add(step=f.step, i=ids[c.i][new], j=j[new], delta=c.delta[new], approach=c.approach[new], window=window)
 
     def open_at_start(self, f, n: int) -> None:
@@ -345,17 +349,17 @@ class Post:
             for f in self.frames(self.reader(paths, computes=self.computes)):
                 progress.update(f.time, f"; reading the contact dumps of {cid}: {found.count()} collisions found")
                 if f.kind not in ("pair", "wall"):
-                    raise DumpError(f.file, f.step, f.line, "not a dump of compute pair/gran/local or wall/gran/local")
+                    raise DumpError(f.file, f.timestep, f.line, "not a dump of compute pair/gran/local or wall/gran/local")
                 missing = [g for g in ("x_i", "v_i", "id_i") + (("x_j", "v_j", "id_j") if f.kind == "pair"
                                                                   else ("x_contact", "v_wall", "mesh"))
                            if g not in f.groups]
                 if missing:
-                    raise DumpError(f.file, f.step, f.line, f"contact dump lacks {', '.join(missing)}: the compute "
+                    raise DumpError(f.file, f.timestep, f.line, f"contact dump lacks {', '.join(missing)}: the compute "
                                                             "needs the keywords pos, vel and id, all dumped")
-                window = (f.step - previous) * self.dt if previous is not None else None
+                window = f.time - previous[1] if previous is not None else None
                 if previous is not None:
-                    intervals.append(f.step - previous)
-                previous = f.step
+                    intervals.append((window, f.step - previous[0]))
+                previous = (f.step, f.time)
                 if len(f):
                     self.add_dump_contacts(f, cid, first, found, window)
                 else:
@@ -399,7 +403,7 @@ class Post:
         far = np.flatnonzero(np.linalg.norm(d, axis=1) > tol)
         if len(far):
             k = far[0]
-            raise DumpError(f.file, f.step, f.line,
+            raise DumpError(f.file, f.timestep, f.line,
                             f"particle {ids_i[seen][k]} is at {f.vector('x_i')[seen][k].tolist()} m here and at "
                             f"{x[rows[seen][k]].tolist()} m in the particle dumps at the same step: the contact "
                             "dumps are not of the run the particle dumps are of")
@@ -441,7 +445,7 @@ class Post:
         known = (ids < len(self.particles.type)) & (ids > 0)
         known[known] = self.particles.type[ids[known]] > 0
         if not known.all():
-            raise DumpError(f.file, f.step, f.line, f"particle id {ids[~known][0]} is in no particle dump")
+            raise DumpError(f.file, f.timestep, f.line, f"particle id {ids[~known][0]} is in no particle dump")
         return ids
 
     # -- physics from the plugin ---------------------------------------------------------------
@@ -498,11 +502,11 @@ class Post:
         v = float(v0.max()) if np.any(v0 > 0) else 1.0
         t_c = min(hertz_collision_time(Y, R[(mi == a) & (mj == b)].min(), m[(mi == a) & (mj == b)].min(), v)
                   for (a, b), (Y, _) in self.dem_laws(mi, mj).items())
-        interval = self.interval * self.dt
+        interval, steps = self.interval
         self.summary.update(dump_interval_s=interval, shortest_collision_s=t_c)
         if interval > t_c:
             self.warnings.append(
-                f"the dump interval {interval:.3g} s ({self.interval} steps) exceeds the shortest DEM collision "
+                f"the dump interval {interval:.3g} s ({steps} steps) exceeds the shortest DEM collision "
                 f"time {t_c:.3g} s (Hertz, at {v:.3g} m/s): collisions shorter than the interval are missed "
                 "and impact speeds are carried back over up to the whole interval")
 
@@ -605,7 +609,7 @@ class Post:
                     self.summary["capped"][m] += capped
                     self.summary["heat_J"][m] += float(np.abs(moved).sum())
                 np.add.at(pair_sum, pair_of[s], np.abs(Q[self.models[0]][s]))
-                cols = [c["step"][s] * self.dt, c["i"][s], np.where(wall[s], 0, c["j"][s]), type_i[s], type_j[s],
+                cols = [self.clock.time(c["step"][s]), c["i"][s], np.where(wall[s], 0, c["j"][s]), type_i[s], type_j[s],
                         np.where(wall[s], w[s] + 1, 0), c["v0"][s]]
                 for m in self.models:
                     cols += [Q[m][s], e[m][s], t_coll[m][s]]
@@ -631,7 +635,7 @@ class Post:
                 ids = f["id"].astype(np.int64)
                 if self.temperatures == "dumps":      # the run's own temperatures from here to the next frame
                     if column is None:
-                        raise DumpError(f.file, f.step, f.line, "--temperatures dumps: the frame has no particle "
+                        raise DumpError(f.file, f.timestep, f.line, "--temperatures dumps: the frame has no particle "
                                                                 "temperature (f_Temp)")
                     for m in self.models:
                         T[m][ids] = f[column]

@@ -193,14 +193,19 @@ void collheat_flush(void *ptr)
     if (lmp->logfile) std::fflush(lmp->logfile);
 }
 
-// Send LIGGGHTS' screen output to another file from now on (for a forked copy: the
-// parent's stream is left alone, its buffer was flushed before the fork).
-int collheat_set_screen(void *ptr, const char *path)
+// A forked copy's output from now on: its screen to another file (the parent's stream is
+// left alone, its buffer was flushed before the fork), no log, and no dump or restart file
+// written at a set-up (update->restrict_output, which Output::setup obeys): the copy shares
+// the parent's open files, and a set-up after a reset_timestep would write the dump's frame
+// of that step into them a second time, before the parent writes it.
+int collheat_trial_output(void *ptr, const char *path)
 {
     LAMMPS *lmp = static_cast<LAMMPS *>(ptr);
     FILE *f = std::fopen(path, "w");
     if (!f) return -1;
     lmp->screen = f;
+    lmp->logfile = nullptr;
+    lmp->update->restrict_output = 1;
     return 0;
 }
 

@@ -51,7 +51,7 @@ class CaseCommands(Effect):
 
     def couple(self) -> None:
         loop = self.loop
-        k = (loop.dem.step - loop.t0_step) // loop.every["couple"]    # CFDEM's coupling step, from 1
+        k = loop.steps // loop.every["couple"]    # CFDEM's coupling step, from 1
         t0, t1 = self.start_time + (k - 1) * self.interval, self.start_time + k * self.interval
         wrote = write_times(self.control, self.start_time, t0, t1) > 0 if any(
             c.when == "write" for c in self.commands) else False

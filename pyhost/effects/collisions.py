@@ -42,7 +42,7 @@ ON_RANKS = True
 False: rank 0 moves all in time order (``harvest_partly`` between frames, else on the atoms
 the frame gathers), the reference tests/cases/test_mpi.py compares it with."""
 
-COLLISION_COLUMNS = ("time", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
+COLLISION_COLUMNS = ("time", "step", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 
 
 def ended_later(begin, ends) -> np.ndarray:
@@ -203,7 +203,7 @@ class CollisionHeat(Effect):
         loop, balance = self.loop, self.loop.balance
         models = self.scene.effects.heat_models
         setup = RankHeat(loop.materials, loop.type_material, loop.capacity, tuple(models),
-                         self.scene.effects.heat_path, self.T_wall, self.wall_material, self.dem.dt,
+                         self.scene.effects.heat_path, self.T_wall, self.wall_material, loop.clock,
                          np.packbits(balance.seen), len(balance.seen),
                          loop.known.T if loop.known.by == "type" else None, self.restitution)
         parts = self.dem.each_rank(on_rank, setup)
@@ -335,8 +335,7 @@ class CollisionHeat(Effect):
         begin = begin[np.lexsort((begin["j"], begin["i"], begin["wall"], begin["step"]))]
         if not len(begin):
             return []
-        cols = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["step"] * self.dem.dt,
-                            T_begin=begin["T"])
+        cols = self.collide(atoms, begin["i"], begin["j"], begin["vn"], begin["step"], T_begin=begin["T"])
         if self.dem.events.window:              # each collision's model time, until its flux history comes
             pair = ~begin["wall"] | np.isin(begin["j"], list(self.conducting))
             keys = contact_keys(begin["i"][pair], begin["j"][pair]).tolist()
@@ -400,9 +399,9 @@ class CollisionHeat(Effect):
         np.add.at(atoms.T, b, q / self.loop.C[b])
         self.totals["heat_gran_undone"] += float(np.abs(q).sum())
 
-    def collide(self, atoms, ids_i, j, v0, time, T_begin=None) -> dict:
+    def collide(self, atoms, ids_i, j, v0, step, T_begin=None) -> dict:
         """Collisions of particles ``ids_i`` with partners ``j`` (ids, or WALL_BASE + wall) at
-        impact speeds v0 [m/s], begun at ``time`` [s]: the plugin's heat moved in this order
+        impact speeds v0 [m/s], begun at LIGGGHTS' step ``step`` of the run under way: the plugin's heat moved in this order
         (``plugins.heat.batch.move_heat``). Returns their columns of the collision log (Q, e
         and t_coll zero without particle temperatures): ``record`` counts and writes them.
         ``T_begin`` (n, 2) [K]: the two temperatures when each began (NaN: as now), where
@@ -423,7 +422,7 @@ class CollisionHeat(Effect):
             self.totals["capped"] += capped
             if flagged.any():
                 self.flag_outside_range(int(flagged.sum()), float(np.max(v0[flagged])))
-        return dict(time=time, i=ids_i, j=np.where(wall, 0, j), wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0,
+        return dict(time=self.loop.time_of(step), step=step, i=ids_i, j=np.where(wall, 0, j), wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0,
                     model=np.full(len(i), models[0] if models else "none"), **heat)
 
     def record(self, cols: dict) -> None:

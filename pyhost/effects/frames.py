@@ -26,16 +26,16 @@ class Frames(Effect):
         logs = logs or {}
         self.group_names = list(loop.known.names)
         self.others = others
-        self.columns = (("time", "particles", "T_mean", "T_min", "T_max")
+        self.columns = (("time", "step", "particles", "T_mean", "T_min", "T_max")
                         + tuple(f"T_group{k}" for k in range(len(self.group_names))) + ("sum_mcT",) + TOTAL_COLUMNS
                         + sum((e.columns for e in others), ()))
         self.history = CsvLog(loop.out / "history.csv", self.columns, logs.get("history"))
         self.particles = VtkSeries(loop.out / "vtk", "particles", logs.get("particles")) if loop.scene.output.vtk else None
-        self.last_step = None           # the step of the last frame
+        self.last_step = None           # the loop's coupled steps at the last frame
 
     def frame(self) -> None:
         loop = self.loop
-        self.last_step = loop.dem.step
+        self.last_step = loop.steps
         heat = loop.heat
         atoms = loop.dem.atoms(heat)
         T = atoms.T if heat else np.full(len(atoms.id), np.nan)
@@ -47,7 +47,7 @@ class Frames(Effect):
                       if np.any(group == k) else math.nan for k in range(len(self.group_names)))
         stats = (float(T.mean()), float(T.min()), float(T.max())) if len(T) else (math.nan,) * 3
         totals = tuple(loop.totals[k] for k in TOTAL_COLUMNS)
-        self.history.write([(loop.t, len(atoms.id)) + stats + means + (float(np.sum(C * T)),) + totals
+        self.history.write([(loop.t, loop.dem.step, len(atoms.id)) + stats + means + (float(np.sum(C * T)),) + totals
                             + sum((e.row(atoms) for e in self.others), ())])
         if self.particles is not None:
             change = T - loop.balance.T_first_by_id[atoms.id] if heat else T

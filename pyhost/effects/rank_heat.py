@@ -44,8 +44,9 @@ class RankHeat:
     the scene's materials (real and DEM, ``plugins.heat.batch``), the material index of each
     atom type (-1: none), the heat capacity of each material [J/(kg K)], the heat models (the
     first moves heat, the others are side columns), the plugin's path, each wall's
-    temperature [K] (NaN: adiabatic) and real material (-1: the particle's), the DEM time
-    step [s], which ids rank 0 has seen (``np.packbits``, ``seen_count`` of them) and the
+    temperature [K] (NaN: adiabatic) and real material (-1: the particle's), the run's clock
+    (``Coupling.clock``: a collision's time [s] from its step), which ids rank 0 has seen
+    (``np.packbits``, ``seen_count`` of them) and the
     temperature [K] an atom of each type starts at (NaN: its own; None: rank 0 sets them);
     with ``restitution`` (feedback), the ENDs and the collisions' events go to rank 0 too."""
 
@@ -56,7 +57,7 @@ class RankHeat:
     path: str
     T_wall: np.ndarray
     wall_material: np.ndarray
-    dt: float
+    clock: tuple
     seen: np.ndarray
     seen_count: int
     T_of_type: np.ndarray | None
@@ -163,7 +164,8 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
         result["begun"] = ev[go]
     result.update(ids=ids[changed], mass=mass[changed].copy(), type=types[changed].copy(),
                   T_before=T_before[changed], T_after=T[changed].copy(), step=ev["step"][go], jj=j[go],
-                  cols=dict(time=ev["step"][go] * setup.dt, i=i[go], j=np.where(w, 0, j[go]),
+                  cols=dict(time=setup.clock[0] + (ev["step"][go] - setup.clock[1]) * setup.clock[2],
+                            step=ev["step"][go], i=i[go], j=np.where(w, 0, j[go]),
                             wall=np.where(w, code + 1, 0), v0=ev["vn"][go],
                             model=np.full(len(go), setup.models[0]), **heat))
     return result

@@ -64,7 +64,7 @@ _HELPER_DECLARATIONS = {
     "collheat_failure": (_cp, []),
     "collheat_context": (None, [_cp]),
     "collheat_flush": (None, [_vp]),
-    "collheat_set_screen": (_int, [_vp, _cp]),
+    "collheat_trial_output": (_int, [_vp, _cp]),
     "collheat_compute_local": (_int, [_vp, _cp, _c.POINTER(_int), _c.POINTER(_int),
                                       _c.POINTER(_c.POINTER(_c.c_double))]),
     "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
@@ -343,7 +343,7 @@ class Liggghts:
             if pid == 0:  # the copy: never returns into Python's normal flow
                 try:
                     self.helper.collheat_watch_exit(self.ptr, b"")  # the parent reports, not the copy
-                    self.helper.collheat_set_screen(self.ptr, str(trial).encode())
+                    self.helper.collheat_trial_output(self.ptr, str(trial).encode())
                     failed = call()
                     self.helper.collheat_flush(self.ptr)
                     os._exit(1 if failed else 0)

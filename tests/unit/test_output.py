@@ -152,14 +152,14 @@ def test_a_damaged_schema_names_the_column(tmp_path, damage, message):
 
 
 @pytest.mark.parametrize("damage, message", [
-    (lambda lines: lines.insert(2, "0.5,1,2"), r"collisions.csv: line 3: 3 fields, the header has 9"),
+    (lambda lines: lines.insert(2, "0.5,1,2"), r"collisions.csv: line 3: 3 fields, the header has 10"),
     (lambda lines: lines.__setitem__(1, lines[1].replace("0.25", "x.25", 1)), r"line 2, column time: 'x.25' is not"),
 ])
 def test_a_damaged_collision_log_names_file_and_line(tmp_path, damage, message):
     """A collisions.csv cut or edited by hand: ValueError naming the file, the line and the
     column (it was numpy's message, with neither)."""
     log = CsvLog(tmp_path / "collisions.csv", COLLISION_COLUMNS)
-    log.write([(0.25, 1, 2, 0, 0.1, 1e-6, 0.8, 1e-5, "A"), (0.5, 2, 3, 0, 0.2, 2e-6, 0.7, 1e-5, "A")])
+    log.write([(0.25, 25000, 1, 2, 0, 0.1, 1e-6, 0.8, 1e-5, "A"), (0.5, 50000, 2, 3, 0, 0.2, 2e-6, 0.7, 1e-5, "A")])
     log.close()
     lines = (tmp_path / "collisions.csv").read_text().splitlines()
     damage(lines)

@@ -34,7 +34,7 @@ def test_a_rank_moves_its_collisions_in_order_and_leaves_the_rest_to_rank_0():
                      (BEGIN, 31, 1, 3, 0.0, False)])
     seen = np.array([False, True, True, True])      # by id: 1-3 seen
     setup = RankHeat([steel], np.array([-1, 0]), np.array([steel.heat_capacity]), ("A",), "exact",
-                     np.array([500.0]), np.array([-1]), 1e-6, np.packbits(seen), len(seen), np.array([np.nan, 320.0]))
+                     np.array([500.0]), np.array([-1]), (0.0, 0, 1e-6), np.packbits(seen), len(seen), np.array([np.nan, 320.0]))
     got = on_rank(atoms, events, None, setup)
 
     # the reference: atom 4 at its material's 320 K, then one collision after the other in
