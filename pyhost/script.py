@@ -22,7 +22,6 @@ REFUSED = {
     "label": "loops and jumps need LIGGGHTS' own input loop",
     "next": "loops and jumps need LIGGGHTS' own input loop",
     "quit": "the host ends the run itself",
-    "shell": "the host does not run shell commands for a script",
 }
 
 class ScriptError(ValueError):
@@ -113,6 +112,8 @@ def read_script(path: str | Path, folder: str | Path | None = None) -> list[Comm
                               "command by command (unroll the loop, or give the values as variables)")
         if cmd.name == "if":
             _check_if(cmd)
+        if cmd.name == "shell":
+            _check_shell(cmd)
         if cmd.name == "delete_atoms":
             _check_delete(cmd)
         if cmd.name == "units" and cmd.text.split()[1:] != ["si"]:
@@ -165,6 +166,15 @@ def _check_delete(cmd: Command) -> None:
                       "collision log): add 'compress no' to the command")
 
 
+def _check_shell(cmd: Command) -> None:
+    """``shell`` runs in the host's own process, as LIGGGHTS runs it: ``mkdir``, ``rm``,
+    ``putenv`` or a program. But ``shell cd`` would move the whole host (its output folder,
+    the fluid case) along with LIGGGHTS' relative paths."""
+    if cmd.words[1:2] == ["cd"]:
+        raise ScriptError(f"{cmd.where()}: 'shell cd': it would move the host's own working folder with "
+                          "LIGGGHTS'; give the script's paths relative to its folder instead")
+
+
 def _check_if(cmd: Command) -> None:
     """The commands inside ``if ... then "..." [elif ... "..."] [else "..."]`` run inside
     LIGGGHTS, where the host cannot couple them: a ``run`` there would be uncoupled steps
@@ -173,7 +183,11 @@ def _check_if(cmd: Command) -> None:
         words = cmd.words
     except ValueError:
         return                          # unbalanced quotes: LIGGGHTS says so itself
-    inner = [w.split(None, 1)[0] for w in words[2:] if w not in ("then", "elif", "else") and w.strip()]
+    inner_commands = [w for w in words[2:] if w not in ("then", "elif", "else") and w.strip()]
+    inner = [w.split(None, 1)[0] for w in inner_commands]
+    for text in inner_commands:
+        if text.split()[:2] == ["shell", "cd"]:
+            _check_shell(Command(text, cmd.file, cmd.line))
     for name in inner:
         if name == "run" or name in REFUSED:
             why = ("the host couples every run itself: write the run outside the if (give its steps as a variable)"
@@ -183,9 +197,10 @@ def _check_if(cmd: Command) -> None:
 
 BOX = ("create_box", "read_data", "read_restart")
 STATE = {"create_atoms", "delete_atoms", "displace_atoms", "set", "velocity", "read_dump", "change_box",
-         "reset_timestep", "group", "write_restart", "write_data", "write_dump", "print", *BOX}
+         "reset_timestep", "group", "write_restart", "write_data", "write_dump", "print", "shell", *BOX}
 """Commands whose effect is in LIGGGHTS' restart file (atoms and their values, groups, the box,
-the step) or that only wrote output: a restart does not replay them."""
+the step) or that only wrote output or acted on files (``shell``: its folders are there, and a
+``shell rm`` done again would remove what the run wrote since): a restart does not replay them."""
 
 
 def replay(commands: list[Command], upto: int, restart: Path) -> list[Command]:

@@ -243,6 +243,8 @@ class Liggghts:
             self._new = True
         elif line in self._known:       # run before without error (a CFDEM case's command at every
             pass                        # coupling step): not tried again; an error returns (the helper)
+        elif line.split()[:1] == ["shell"]:
+            self._ahead = []            # not in a copy: its files and programs would be acted on twice
         else:
             self._ahead = []
             self._tried(lambda: self._call(line), line)
@@ -257,6 +259,8 @@ class Liggghts:
         they come next, in this order. From the first that fails there (or that the copy dies
         in), each is tried alone when it comes, which reports its error as usual."""
         self._ahead = []
+        shell = next((k for k, line in enumerate(lines) if line.split()[:1] == ["shell"]), len(lines))
+        lines = lines[:shell]           # (a shell command is not tried: see command)
         if not self.check or len(lines) < 2:
             return
         passed = self.workdir / "log.trial.passed"

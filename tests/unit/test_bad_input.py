@@ -54,7 +54,8 @@ def test_cli_bad_input_one_line_exit_2(args, word):
 
 @pytest.mark.parametrize("line, message", [
     ('if "${a} > 1" then "run 200"', "'run' inside 'if': the host couples every run itself"),
-    ('if "${a} > 1" then "print hi" else "shell rm x"', "'shell' inside 'if': the host does not run shell commands"),
+    ('if "${a} > 1" then "print hi" else "shell cd post"', "'shell cd': it would move the host's own working folder"),
+    ("shell cd post", "'shell cd': it would move the host's own working folder"),
     ("run 100 every 10 \"print x\"", "'run ... every' is not supported by the host"),
     ("delete_atoms region out", "'delete_atoms' renumbers the remaining atoms' ids .* add 'compress no'"),
     ("delete_atoms region out compress yes", "'delete_atoms' renumbers"),
