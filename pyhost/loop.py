@@ -39,7 +39,7 @@ from pyhost.engines.liggghts import LiggghtsError
 from pyhost.failures import InvariantBroken, particles_lost
 from pyhost.outdir import write_atomic
 from pyhost.output import Progress
-from pyhost.script import ScriptError, parse_run, replay
+from pyhost.script import Program, ScriptError, if_branches, parse_run, replay
 
 HARVEST_EVERY = 1000
 """DEM steps between harvests of the contact events at most (they are also taken at every
@@ -144,7 +144,7 @@ class Coupling:
                                         self.frames) if e is not None]
         if events:                           # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
-        self.command, self.run_left = -1, 0  # the script's run under way (its index) and its steps to go
+        self.program, self.run_left = {}, 0  # where the script stands at the run under way (Program.state), its steps to go
         self.inputs = ()                     # the script's files (a restart checks them)
         self.extend = 0.0                    # run --extend [s] (a checkpoint keeps it)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
@@ -290,7 +290,7 @@ class Coupling:
         for effect in self.effect_list:    # every frame a log names on disk
             effect.flush()
         values = dict(clock=self.clock, t_step=self.t_step, t_begin=self.t_begin, steps=self.steps, t=self.t, totals=self.totals, warned=sorted(self.warned),
-                      command=self.command, run_left=self.run_left, mesh_motion=self.dem.mesh_motion_times(),
+                      program=self.program, run_left=self.run_left, mesh_motion=self.dem.mesh_motion_times(),
                       randoms=self.dem.random_states())
         arrays, logs = {}, {}
         for effect in self.effect_list:
@@ -345,39 +345,52 @@ class Coupling:
         return summary
 
 
-def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end: float | None = None,
+def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, fluid=None, end: float | None = None,
               max_time: float | None = None, driven: float | None = None, extend: float = 0.0,
               progress_every: float = 5.0, log=print, **particles) -> dict:
-    """Run a script's commands on ``dem``; each ``run N`` is N coupled steps (steps beyond
-    ``max_time`` [s] of coupled time, for smoke runs, are cut). ``driven`` [s]: how long the
-    script's last ``run`` lasts when it asks for 0 steps (a CFD-DEM script whose coupling
-    drives the run, as CFDEM's end in ``run 0``); in a CFDEM script (``fix couple/cfd``) the
-    last run's own steps come first, as CFDEM runs them before its coupling. ``extend`` [s]: how
-    much longer than written the script's last run goes on (``run --extend``, a restart's; a box
-    scene's end comes extended). With ``output.checkpoint`` a completed run ends in a
-    checkpoint, from which ``--extend`` goes on. ``walls_of(dem)`` gives the HostWalls once the
-    script's walls exist; ``particles``: type_material, known and resume of ``Coupling``.
-    Returns the summary, also written when a step fails; a script whose runs simulate no step
-    at all is refused (ScriptError) rather than ending as done."""
+    """Run the script ``script`` on ``dem`` as LIGGGHTS' input loop runs it (``Program``: includes,
+    labels and jumps, loops with ``next``, ``if`` branches and ``run ... every``, ``quit``);
+    ``commands`` are its commands as read and checked (``read_script``). Each ``run N`` is N
+    coupled steps (steps beyond ``max_time`` [s] of coupled time, for smoke runs, are cut).
+    ``driven`` [s]: how long the script's last ``run`` lasts when it asks for 0 steps (a CFD-DEM
+    script whose coupling drives the run, as CFDEM's end in ``run 0``); in a CFDEM script (``fix
+    couple/cfd``) the last run's own steps come first, as CFDEM runs them before its coupling.
+    ``extend`` [s]: how much longer than written the script's last run goes on (``run
+    --extend``, a restart's; a box scene's end comes extended). The last run is the script's
+    last ``run`` command when no ``jump`` follows it. With ``output.checkpoint`` a completed run
+    ends in a checkpoint, from which ``--extend`` goes on. ``walls_of(dem)`` gives the HostWalls
+    once the script's walls exist; ``particles``: type_material, known and resume of
+    ``Coupling``. Returns the summary, also written when a step fails; a script whose runs
+    simulate no step at all is refused (ScriptError) rather than ending as done."""
     coupling = None
     effects = scene.effects_summary()
     resume = particles.get("resume")
-    # a script restarted: its set-up replayed up to the run the checkpoint interrupted, that run's
-    # steps to go, then the rest as written (a box scene's generated script reads the restart itself)
+    # a script restarted: the commands it ran replayed up to the run the checkpoint interrupted (its
+    # set-up), that run's steps to go, then the script on from where its input loop stood (a box
+    # scene's generated script reads the restart itself)
     restarting = resume is not None and scene.scripted
-    restart_from = int(resume["command"]) if restarting else 0
-    replayed = 0                        # the replayed set-up's length: commands[replayed] is the run
+    queue = []                          # (command, "replayed" | "interrupted") before the program's own
     if restarting:
-        if not 0 <= restart_from < len(commands) or commands[restart_from].name != "run":
-            raise ScriptError(f"--restart: the checkpoint's run is command {restart_from} of {scene.path}'s "
-                              "script, which is not a run there (the script was changed?)")
-        setup = replay(commands, restart_from, resume["restart"])
-        commands, replayed = setup + commands[restart_from:], len(setup)
-    last_run = max((k for k, c in enumerate(commands) if c.name == "run"), default=-1)
+        if "program" not in resume:
+            raise ScriptError("--restart: the checkpoint was written by an older version of the host (it does not "
+                              "say where the script's input loop stood): start the run anew")
+        program = Program.restore(resume["program"], scene.folder)
+        trace = program.trace
+        if not trace or trace[-1].name != "run":
+            raise ScriptError(f"--restart: the checkpoint's last command of {scene.path}'s script is not a run")
+        queue = [(c, "replayed") for c in replay(trace, len(trace) - 1, resume["restart"])]
+        queue.append((trace[-1], "interrupted"))
+    else:
+        program = Program(script, scene.folder)
+    at = max((k for k, c in enumerate(commands) if c.name == "run"), default=-1)
+    last_run = commands[at] if at >= 0 else None
+    final_run = last_run if not any(c.name == "jump" for c in commands[at + 1:]) else None
+    if extend and final_run is None and scene.scripted:
+        raise ScriptError(f"--extend: {scene.path}'s script jumps back after its last run command, so the host "
+                          "cannot tell which run is the last to extend")
     # CFDEM runs a script whole (its last run too: often 'run 1'), then its coupling drives the DEM
     cfdem = any(c.name == "fix" and c.words[3:4] == ["couple/cfd"] for c in commands)
     prepared = None
-
     held = []                           # the reset_timestep commands right before the first run
 
     def prepare(cmd):
@@ -391,43 +404,96 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                "reset_timestep and its run)" if added and held else ""))
         return added
 
+    def take():
+        """The next command and how it comes: replayed, the interrupted run, or the script's own (None)."""
+        if queue:
+            return queue.pop(0)
+        return program.take(), None
+
+    def plain(cmd, how) -> list:
+        """``cmd`` and the plain commands that follow it (taken), up to the next run, if, jump or
+        include; the reset_timesteps that end them before the first run held for ``prepare``."""
+        if how is None:
+            batch = [cmd] + program.plain_ahead()
+            for _ in batch[1:]:
+                program.take()
+            after = program.peek()
+        else:
+            batch = [cmd]
+            while queue and queue[0][0].name != "run":
+                batch.append(queue.pop(0)[0])
+            after = queue[0][0] if queue else None
+        cut = len(batch)
+        while prepared is None and after is not None and after.name == "run" and cut > 0 \
+                and batch[cut - 1].name == "reset_timestep":
+            cut -= 1                    # the host's fixes go in before them (prepare)
+        held[:] = batch[cut:]
+        return batch[:cut]
+
     try:
-        for k, cmd in enumerate(commands):
+        while True:
+            cmd, how = take()
+            if cmd is None:
+                break
+            if cmd.name == "if":        # (the program's own only: a trace holds the branch taken)
+                conditions, branches = if_branches(cmd)
+                dem.context(cmd)
+                try:
+                    k = dem.branch(conditions)
+                except LiggghtsError as exc:
+                    raise LiggghtsError(f"{cmd.where()}: {exc}") from None
+                program.push(cmd, branches[k])
+                continue
             if cmd.name != "run":
-                if k == 0 or commands[k - 1].name == "run":     # the commands up to the next run
-                    upto = next((m for m in range(k, len(commands)) if commands[m].name == "run"), len(commands))
-                    cut = upto
-                    while prepared is None and upto < len(commands) and cut > k \
-                            and commands[cut - 1].name == "reset_timestep":
-                        cut -= 1                # the host's fixes go in before them (prepare)
-                    held[:] = commands[cut:upto]
-                    dem.commands(commands[k:cut])
+                batch = plain(cmd, how)
+                dem.commands(batch)
+                if how is None:
+                    program.trace += batch + held
+                if any(c.name == "next" for c in batch):
+                    skip = dem.jump_skipped()
+                    if how is None:     # (replayed: the checkpoint says where the loop stood)
+                        program.skip_jump = program.skip_jump or skip
                 continue
             dem.context(cmd)
             run = parse_run(cmd)
             if not dem.dt > 0:
                 raise ScriptError(f"{cmd.where()}: the time step is {dem.dt:g} s: give the script a positive "
                                   "'timestep' before its runs")
-            if k < replayed:                # a run before the restart's: the host's fixes come at the first
+            if run.every is not None and how is None:    # chunks of M steps, the commands after each
+                try:
+                    n, m = dem.steps(run.steps, run.upto), dem.steps(run.every, False)
+                except ScriptError as exc:
+                    raise ScriptError(f"{cmd.where()}: {exc}") from None
+                if m <= 0 or n % m:
+                    raise ScriptError(f"{cmd.where()}: run {n} every {m}: {n} steps are not a whole number of "
+                                      f"chunks of {m} (LIGGGHTS: 'Invalid run command N value')")
+                program.push(cmd, [c for k in range(n // m)        # (pre no: LIGGGHTS sets up the first only)
+                                   for c in [f"run {m}" + ("" if run.pre or k == 0 else " pre no"), *run.then]])
+                continue
+            if how == "replayed":       # a run before the restart's: the host's fixes come at the first
                 if prepared is None:
                     prepared = prepare(cmd)
                 continue
+            if how is None:
+                program.trace.append(cmd)
             if coupling is None:
                 if prepared is None:
                     prepared = prepare(cmd)
-                elif k == replayed:         # the replayed commands since the host's fixes: set up, then
+                elif how == "interrupted":  # the replayed commands since the host's fixes: set up, then
                     dem.run(0)              # the checkpoint's forces go back (Coupling's restore)
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, driven=driven, **particles)
                 if scene.scripted:           # a restart replays them: checked unchanged
-                    coupling.inputs = tuple(sorted({c.file for c in commands if c.file != "(host)"}))
+                    jumped = {str(Path(scene.folder) / c.words[1]) for c in commands
+                              if c.name == "jump" and c.words[1] != "SELF"}
+                    coupling.inputs = tuple(sorted({c.file for c in commands if c.file != "(host)"} | jumped))
                 coupling.extend = extend
                 coupling.start()
             else:
                 coupling.update_walls(walls_of(dem))
                 coupling.check_heat_gran()
-            coupling.command = k - replayed + restart_from
-            if restarting and k == replayed:
+            coupling.program = program.state()
+            if how == "interrupted":
                 n = int(resume["run_left"])
                 log(f"{cmd.where()}: restarted in this run, {n} steps to go")
             else:
@@ -435,19 +501,22 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                     n = dem.steps(run.steps, run.upto)
                 except ScriptError as exc:
                     raise ScriptError(f"{cmd.where()}: {exc}") from None
-            if k == last_run and driven is not None and (n == 0 or cfdem) and not (restarting and k == replayed):
+            last = cmd == final_run and run.every is None
+            if last and driven is not None and (n == 0 or cfdem) and how != "interrupted":
                 more = round(driven / dem.dt)
                 log(f"{cmd.where()}: " + ("the script ends in a run of 0 steps, which the coupling drives" if n == 0
                     else f"a CFDEM script (fix couple/cfd): its last run's {n} steps, then the coupling drives")
                     + f": {driven:g} s ({more} steps; [time] end, else the fluid case's controlDict endTime)")
                 n += more
-            if k == last_run and scene.scripted and extend:
-                more = round((extend - resume["extend"] if restarting and k == replayed else extend) / dem.dt)
+            if last and scene.scripted and extend:
+                more = round((extend - resume["extend"] if how == "interrupted" else extend) / dem.dt)
                 n += more
                 if more:
                     log(f"{cmd.where()}: --extend {extend:g}: {more} steps more than the case asks")
             if max_time is not None:
                 n = min(n, round((max_time - (coupling.t - coupling.t_begin)) / dem.dt))
+            if run.pre and how != "interrupted" and not (resume is not None and not scene.scripted):
+                dem.set_up_next()       # (not the run a restart continues: from the checkpoint's forces)
             if n > 0:
                 try:
                     coupling.advance(n)
@@ -456,7 +525,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
             dem.report_warnings(cmd)
         if coupling is not None and coupling.steps == 0:
             raise ScriptError(f"{scene.path}: the script's runs simulate no step (its last is "
-                              f"{commands[last_run].where()}: '{commands[last_run].text}'); give the steps in "
+                              f"{last_run.where()}: '{last_run.text}'); give the steps in "
                               f"the script" + (", or the coupled time as [time] end" if fluid is not None else ""))
         if coupling is not None and scene.output.checkpoint:    # a completed run ends in a checkpoint, marked
             if coupling.checkpoint_step != coupling.steps:       # so: --extend goes on from there

@@ -3,10 +3,12 @@ by command and turn each ``run N`` into N coupled steps.
 
 ``read_script(path)`` gives the commands with their file and line: '#' comments dropped
 (outside quotes), '&' continuation lines joined, ``include FILE`` expanded in place (paths
-relative to the case folder, where the script runs). Commands that need LIGGGHTS' own
-input loop (``jump``, ``label``, ``next``) cannot be run one by one and are refused with
-their line. ``$`` variables are left to LIGGGHTS, which substitutes them when each command
-runs. The ``parse_*`` helpers read what the host must know about a command: the granular
+relative to the case folder, where the script runs), checked for what the host cannot run.
+``Program`` is LIGGGHTS' own input loop over them, for the host to run: ``include``,
+``label``, ``jump`` (SELF or another file, to a label), ``next`` (whose exhausted variable
+skips the next jump), ``if`` (its branch chosen by LIGGGHTS, its commands run by the host,
+so a ``run`` inside is coupled), ``run N every M "cmd"`` and ``quit``. ``$`` variables are
+left to LIGGGHTS, which substitutes them when each command runs. The ``parse_*`` helpers read what the host must know about a command: the granular
 walls (geometry of a primitive wall, meshes of a mesh wall), contact computes, heat/gran.
 """
 from __future__ import annotations
@@ -17,12 +19,6 @@ from pathlib import Path
 
 from pyhost.walls import PRIMITIVES
 
-REFUSED = {
-    "jump": "loops and jumps need LIGGGHTS' own input loop",
-    "label": "loops and jumps need LIGGGHTS' own input loop",
-    "next": "loops and jumps need LIGGGHTS' own input loop",
-    "quit": "the host ends the run itself",
-}
 
 class ScriptError(ValueError):
     """A script the host cannot run, naming the file and the line."""
@@ -59,12 +55,14 @@ def _strip_comment(line: str) -> str:
     return line
 
 
-def script_commands(path: str | Path, folder: str | Path | None = None, _depth: int = 0) -> list[Command]:
+def script_commands(path: str | Path, folder: str | Path | None = None, _depth: int = 0,
+                    expand: bool = True) -> list[Command]:
     """The commands of a LIGGGHTS script as LIGGGHTS reads them: '#' comments (outside quotes)
-    dropped, '&' continuations joined, included files read in their place; each with its file
-    and first line. ``folder``: where relative include paths are found (default the script's
-    own folder). ScriptError for a file that is missing or not text, an include nested more
-    than 20 deep or of a variable file name, or a script ending inside a continuation."""
+    dropped, '&' continuations joined, included files read in their place (``expand``; else
+    the ``include`` commands stay); each with its file and first line. ``folder``: where
+    relative include paths are found (default the script's own folder). ScriptError for a
+    file that is missing or not text, an include nested more than 20 deep or of a variable
+    file name, or a script ending inside a continuation."""
     path = Path(path)
     folder = Path(folder) if folder is not None else path.parent
     if _depth > 20:
@@ -94,8 +92,9 @@ def script_commands(path: str | Path, folder: str | Path | None = None, _depth: 
                 raise ScriptError(f"{cmd.where()}: include takes one file name")
             if "$" in words[1]:
                 raise ScriptError(f"{cmd.where()}: include of a variable file name is not supported")
-            commands += script_commands(folder / words[1], folder, _depth + 1)
-            continue
+            if expand:
+                commands += script_commands(folder / words[1], folder, _depth + 1)
+                continue
         commands.append(cmd)
     if pending:
         raise ScriptError(f"{path}:{first}: the script ends inside a '&' continuation")
@@ -107,9 +106,8 @@ def read_script(path: str | Path, folder: str | Path | None = None) -> list[Comm
     host cannot run refused before any engine time (see the module doc)."""
     commands = script_commands(path, folder)
     for cmd in commands:
-        if cmd.name in REFUSED:
-            raise ScriptError(f"{cmd.where()}: '{cmd.name}': {REFUSED[cmd.name]}; the host runs a script "
-                              "command by command (unroll the loop, or give the values as variables)")
+        if cmd.name == "jump":
+            _check_jump(cmd, Path(folder) if folder is not None else Path(path).parent)
         if cmd.name == "if":
             _check_if(cmd)
         if cmd.name == "shell":
@@ -175,24 +173,63 @@ def _check_shell(cmd: Command) -> None:
                           "LIGGGHTS'; give the script's paths relative to its folder instead")
 
 
+def _check_jump(cmd: Command, folder: Path) -> None:
+    """``jump SELF|FILE [label]``: the host finds the label or file itself, so it takes them as
+    written (LIGGGHTS would substitute ``$`` variables), and the file must exist."""
+    words = cmd.words
+    if not 2 <= len(words) <= 3:
+        raise ScriptError(f"{cmd.where()}: 'jump' takes a file (or SELF) and an optional label")
+    if any("$" in w for w in words[1:]):
+        raise ScriptError(f"{cmd.where()}: '{cmd.text}': a jump to a file or label given as a variable is not "
+                          "supported (the host follows the script's jumps itself): write the name")
+    if words[1] != "SELF" and not (folder / words[1]).is_file():
+        raise ScriptError(f"{cmd.where()}: '{cmd.text}': no script {folder / words[1]}")
+
+
 def _check_if(cmd: Command) -> None:
-    """The commands inside ``if ... then "..." [elif ... "..."] [else "..."]`` run inside
-    LIGGGHTS, where the host cannot couple them: a ``run`` there would be uncoupled steps
-    whose collisions are never seen, and a refused command would slip through."""
+    """The commands inside ``if ... then "..." [elif ... "..."] [else "..."]`` run as the
+    script's own (``Program``), so each is checked as they are."""
+    for branch in if_branches(cmd)[1]:
+        for text in branch:
+            inner = Command(text, cmd.file, cmd.line)
+            if inner.name == "if":
+                _check_if(inner)
+            elif inner.name == "shell":
+                _check_shell(inner)
+            elif inner.name == "run":
+                parse_run(inner)
+
+
+def if_branches(cmd: Command) -> tuple[list[str], list[list[str]]]:
+    """An ``if "c1" then "cmd" ... [elif "c2" "cmd" ...] [else "cmd" ...]`` as its conditions
+    (as written, without quotes) and each condition's commands, the else's last (an empty list
+    where there is no else). ScriptError naming the line for a malformed one."""
     try:
         words = cmd.words
     except ValueError:
-        return                          # unbalanced quotes: LIGGGHTS says so itself
-    inner_commands = [w for w in words[2:] if w not in ("then", "elif", "else") and w.strip()]
-    inner = [w.split(None, 1)[0] for w in inner_commands]
-    for text in inner_commands:
-        if text.split()[:2] == ["shell", "cd"]:
-            _check_shell(Command(text, cmd.file, cmd.line))
-    for name in inner:
-        if name == "run" or name in REFUSED:
-            why = ("the host couples every run itself: write the run outside the if (give its steps as a variable)"
-                   if name == "run" else REFUSED[name])
-            raise ScriptError(f"{cmd.where()}: '{name}' inside 'if': {why}")
+        raise ScriptError(f"{cmd.where()}: 'if' with unbalanced quotes") from None
+    if len(words) < 4 or words[2] != "then":
+        raise ScriptError(f"{cmd.where()}: 'if' needs a condition, 'then' and a command (LIGGGHTS: 'Illegal if command')")
+    conditions, branches, k = [words[1]], [[]], 3
+    while k < len(words):
+        w = words[k]
+        if w == "elif" and k + 2 < len(words):
+            conditions.append(words[k + 1])
+            branches.append([])
+            k += 2
+            continue
+        if w == "else" and len(branches) == len(conditions):
+            branches.append([])
+        elif w in ("elif", "else") or not w.strip():
+            raise ScriptError(f"{cmd.where()}: 'if' with a misplaced '{w}' or an empty command")
+        else:
+            branches[-1].append(w)
+        k += 1
+    if any(not b for b in branches):
+        raise ScriptError(f"{cmd.where()}: 'if' with a branch without commands (LIGGGHTS: 'Illegal if command')")
+    if len(branches) == len(conditions):
+        branches.append([])
+    return conditions, branches
 
 
 BOX = ("create_box", "read_data", "read_restart")
@@ -204,21 +241,18 @@ the step) or that only wrote output or acted on files (``shell``: its folders ar
 
 
 def replay(commands: list[Command], upto: int, restart: Path) -> list[Command]:
-    """The set-up of a script restarted at its command number ``upto`` (a ``run`` that a
-    checkpoint interrupted): commands[:upto] with the first box command (create_box, read_data,
-    read_restart) replaced by ``read_restart`` of the checkpoint's file, what the file holds
-    (``STATE``) left out, and the rest (regions, variables, fixes and unfixes under their ids,
-    which take their state back from the file, computes, pair style, dumps) replayed in order;
-    a dump or log to one file appends to it. Earlier runs stay in the list as markers (the
-    host adds its own fixes at the first, as in the run that wrote the checkpoint); they
-    simulate nothing. ScriptError for a command whose effect the host cannot know (an ``if``)."""
+    """The set-up of a script restarted at its command number ``upto`` of the commands it ran
+    (``Program.trace``: loops unrolled, each ``if`` as the commands of its branch taken), a
+    ``run`` that a checkpoint interrupted: commands[:upto] with the first box command
+    (create_box, read_data, read_restart) replaced by ``read_restart`` of the checkpoint's
+    file, what the file holds (``STATE``) left out, and the rest (regions, variables and their
+    ``next``, fixes and unfixes under their ids, which take their state back from the file,
+    computes, pair style, dumps) replayed in order; a dump or log to one file appends to it.
+    Earlier runs stay in the list as markers (the host adds its own fixes at the first, as in
+    the run that wrote the checkpoint); they simulate nothing."""
     out, box = [], False
     for cmd in commands[:upto]:
         name = cmd.name
-        if name == "if":
-            raise ScriptError(f"--restart: {cmd.where()}: an 'if' before the interrupted run; the host cannot "
-                              "tell what it did, so it cannot restart this script (move it after the last run, "
-                              "or give the values as variables)")
         if name in BOX and not box:
             box = True
             out.append(Command(f"read_restart {restart}", cmd.file, cmd.line))
@@ -237,6 +271,124 @@ def replay(commands: list[Command], upto: int, restart: Path) -> list[Command]:
     return out
 
 
+@dataclass
+class _Frame:
+    """Commands being read: one file's (``file``; its includes not expanded) or an ``if``'s
+    branch or a ``run ... every``'s chunks (``file`` None), and the next one's index."""
+
+    commands: list
+    pc: int = 0
+    file: str | None = None
+
+
+class Program:
+    """LIGGGHTS' input loop over a script, for the host to run command by command: ``take()``
+    gives the next command to run, having followed ``include``, ``label``, ``jump`` (SELF or
+    another file, to the first matching label; skipped once after a ``next`` exhausted its
+    variable, as LIGGGHTS does: ``skip_jump``) and ``quit`` (the end). An ``if`` and a
+    ``run ... every`` come to the caller, who pushes the commands to run (``push``). ``trace``
+    holds what the caller ran, in order (a restart replays it: ``replay``); ``state()`` and
+    ``restore`` carry where the loop stands across a restart."""
+
+    def __init__(self, path: str | Path, folder: str | Path):
+        self.folder = Path(folder)
+        self.frames = [self._file(Path(path))]
+        self.skip_jump = False
+        self.trace: list[Command] = []
+
+    def _file(self, path: Path) -> _Frame:
+        return _Frame(script_commands(path, self.folder, expand=False), 0, str(path))
+
+    def take(self) -> Command | None:
+        """The next command to run (never an include, label or jump), or None at the end."""
+        while self.frames:
+            frame = self.frames[-1]
+            if frame.pc >= len(frame.commands):
+                self.frames.pop()
+                continue
+            cmd = frame.commands[frame.pc]
+            frame.pc += 1
+            if cmd.name == "label":
+                continue
+            if cmd.name == "include":
+                self.frames.append(self._file(self.folder / cmd.words[1]))
+                continue
+            if cmd.name == "jump":
+                self._jump(cmd)
+                continue
+            if cmd.name == "quit":
+                self.frames = []
+                return None
+            return cmd
+        return None
+
+    def plain_ahead(self) -> list[Command]:
+        """The commands that come next in the frame being read, up to the first that is not
+        plain (a run, if, jump, label, include or quit), without taking them."""
+        frame = next((f for f in reversed(self.frames) if f.pc < len(f.commands)), None)
+        if frame is None or frame is not self.frames[-1]:
+            return []
+        ahead = []
+        for cmd in frame.commands[frame.pc:]:
+            if cmd.name in ("run", "if", "jump", "label", "include", "quit"):
+                break
+            ahead.append(cmd)
+        return ahead
+
+    def peek(self) -> Command | None:
+        """The command after ``plain_ahead`` in the same frame, if any."""
+        frame = self.frames[-1] if self.frames else None
+        if frame is None:
+            return None
+        k = frame.pc + len(self.plain_ahead())
+        return frame.commands[k] if k < len(frame.commands) else None
+
+    def push(self, cmd: Command, texts: list[str]) -> None:
+        """Commands to run next (an ``if``'s branch, a ``run ... every``'s chunks), named by
+        ``cmd``'s place in its file."""
+        self.frames.append(_Frame([Command(t, cmd.file, cmd.line) for t in texts]))
+
+    def _jump(self, cmd: Command) -> None:
+        if self.skip_jump:                  # (LIGGGHTS' jump_skip: a loop's variable is exhausted)
+            self.skip_jump = False
+            return
+        words = cmd.words
+        while self.frames and self.frames[-1].file is None:
+            self.frames.pop()               # the rest of an if's commands: LIGGGHTS skips them too
+        if words[1] != "SELF":
+            self.frames[-1] = self._file(self.folder / words[1])
+        top = self.frames[-1]
+        top.pc = 0
+        if len(words) > 2:
+            at = next((k for k, c in enumerate(top.commands) if c.name == "label" and c.words[1:2] == [words[2]]),
+                      None)
+            if at is None:
+                raise ScriptError(f"{cmd.where()}: '{cmd.text}': no 'label {words[2]}' in {top.file} (LIGGGHTS: "
+                                  "'Label wasn't found in input script')")
+            top.pc = at + 1
+
+    def state(self) -> dict:
+        """Where the loop stands (JSON values)."""
+        return dict(skip_jump=self.skip_jump, trace=[[c.text, c.file, c.line] for c in self.trace],
+                    frames=[dict(file=f.file, pc=f.pc) if f.file is not None else
+                            dict(commands=[[c.text, c.file, c.line] for c in f.commands], pc=f.pc)
+                            for f in self.frames])
+
+    @classmethod
+    def restore(cls, state: dict, folder: str | Path) -> "Program":
+        program = cls.__new__(cls)
+        program.folder = Path(folder)
+        program.skip_jump = state["skip_jump"]
+        program.trace = [Command(*c) for c in state["trace"]]
+        program.frames = []
+        for f in state["frames"]:
+            frame = (program._file(Path(f["file"])) if f.get("file") is not None
+                     else _Frame([Command(*c) for c in f["commands"]]))
+            frame.pc = f["pc"]
+            program.frames.append(frame)
+        return program
+
+
 RANDOMS = {"insert": ("insert",), "particledistribution/discrete": ("distribution",),
            "particletemplate/sphere": ("template_insertion", "template_mc")}
 """Fix styles (insert/* as "insert") whose random generators a restart puts back, by the kind
@@ -245,30 +397,45 @@ RANDOMS = {"insert": ("insert",), "particledistribution/discrete": ("distributio
 
 @dataclass(frozen=True)
 class RunCommand:
-    """``run N [upto] [pre yes|no] [post yes|no]``: steps (possibly a $variable, evaluated by
-    the host through LIGGGHTS) and whether N is an end step."""
+    """``run N [upto] [pre yes|no] [post yes|no] [every M "cmd" ...]``: steps (possibly a
+    $variable, evaluated by the host through LIGGGHTS), whether N is an end step, and with
+    ``every`` the chunk M (steps, as written) and the commands run after each chunk; ``pre``:
+    whether the run starts with a full set-up (LIGGGHTS' default, ``pre yes``)."""
 
     steps: str
     upto: bool
+    every: str | None = None
+    then: tuple = ()
+    pre: bool = True
 
 
 def parse_run(cmd: Command) -> RunCommand:
     words = cmd.words
     if len(words) < 2:
         raise ScriptError(f"{cmd.where()}: 'run' needs a number of steps")
-    rest, upto = words[2:], False
+    rest, upto, pre = words[2:], False, True
     while rest:
         key = rest.pop(0)
         if key == "upto":
             upto = True
-        elif key in ("pre", "post") and rest:
+        elif key == "pre" and rest:
+            pre = rest.pop(0) != "no"
+        elif key == "post" and rest:
             rest.pop(0)
         elif key in ("start", "stop") and rest:
             rest.pop(0)
+        elif key == "every" and rest:
+            every = rest.pop(0)
+            then = () if rest == ["NULL"] else tuple(rest)     # (LIGGGHTS' run.cpp: NULL alone is none)
+            if not rest:
+                raise ScriptError(f"{cmd.where()}: 'run ... every {every}' needs its commands (or NULL)")
+            if upto:
+                raise ScriptError(f"{cmd.where()}: 'run ... upto ... every' is not supported by the host")
+            return RunCommand(words[1], upto, every, then, pre)
         else:
             raise ScriptError(f"{cmd.where()}: 'run ... {key}' is not supported by the host (supported: "
-                              "run N [upto] [pre yes|no] [post yes|no])")
-    return RunCommand(words[1], upto)
+                              "run N [upto] [pre yes|no] [post yes|no] [every M \"cmd\" ...])")
+    return RunCommand(words[1], upto, pre=pre)
 
 
 def output_files(cmd: Command) -> list[str]:

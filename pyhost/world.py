@@ -283,7 +283,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         os.chdir(scene.folder)          # the script's relative paths, as with 'liggghts -in' there
         dem = Dem(out / "dem", variables=variables, link=link)
         try:
-            return run_scene(scene, wrap(dem) if wrap else dem, commands, out, max_time=max_time,
+            return run_scene(scene, wrap(dem) if wrap else dem, commands, out, script=script, max_time=max_time,
                              fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
                              end=None if scene.scripted else scene.time.end, driven=driven, extend=extend,
                              progress_every=progress_every,

@@ -87,7 +87,7 @@ if changed liggghts plugins/liggghts "$helper"; then
     echo "setup_engines: compiling plugins/liggghts"
     g++ -O2 -fPIC -shared -DOMPI_SKIP_MPICXX -I/usr/include/liggghts \
         $(pkg-config --cflags ompi 2>/dev/null || echo -I/usr/lib/x86_64-linux-gnu/openmpi/include) \
-        plugins/liggghts/collheat_liggghts.cpp plugins/liggghts/contact_events.cpp plugins/liggghts/restart_state.cpp plugins/liggghts/run_chunks.cpp -o "$helper" -Wl,--no-as-needed -lliggghts -lmpi
+        plugins/liggghts/collheat_liggghts.cpp plugins/liggghts/contact_events.cpp plugins/liggghts/restart_state.cpp plugins/liggghts/run_chunks.cpp plugins/liggghts/input_loop.cpp -o "$helper" -Wl,--no-as-needed -lliggghts -lmpi
     done_build liggghts
 fi
 

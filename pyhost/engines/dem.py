@@ -173,6 +173,28 @@ class Dem:
         return self.lmp.variable("collheat_value")
 
     @collective
+    def branch(self, conditions: list[str]) -> int:
+        """Which branch of a script's ``if`` LIGGGHTS takes now: the index of the first of the
+        ``conditions`` (as written) that holds, ``len(conditions)`` (the else) if none. LIGGGHTS
+        evaluates them itself, in an ``if`` of the same conditions whose branches only say which
+        they are; LiggghtsError with its message if it cannot."""
+        def quoted(text: str) -> str:
+            return f"'{text}'" if '"' in text else f'"{text}"'
+
+        probe = (f"if {quoted(conditions[0])} then \"variable collheat_branch equal 0\""
+                 + "".join(f" elif {quoted(c)} \"variable collheat_branch equal {k}\""
+                           for k, c in enumerate(conditions[1:], 1))
+                 + f" else \"variable collheat_branch equal {len(conditions)}\"")
+        self._raw(probe)
+        self._order("variable", "collheat_branch")
+        return int(self.lmp.variable("collheat_branch"))
+
+    def jump_skipped(self) -> bool:
+        """Whether a ``next`` since the last call exhausted its variable: LIGGGHTS would skip the
+        script's next ``jump`` (rank 0's LIGGGHTS: every rank ran the same ``next``)."""
+        return self.lmp.take_jump_skip()
+
+    @collective
     def steps(self, steps: str, upto: bool) -> int:
         """The number of steps of a ``run`` (a number or a $variable, evaluated by LIGGGHTS)."""
         try:
@@ -234,6 +256,12 @@ class Dem:
             self.set_force(np.zeros((self.count(), 3)))     # memory: zero it and set up again
             self._raw("run 0")
         return added
+
+    @collective
+    def set_up_next(self) -> None:
+        """The next run starts with a full set-up, on every rank (``Liggghts.set_up_next``)."""
+        self._order("set_up_next")
+        self.lmp.set_up_next()
 
     @collective
     def run(self, steps: int) -> None:

@@ -58,6 +58,17 @@ class DemEngine(Protocol):
     def value(self, text: str) -> float:
         """A number of the script as the engine evaluates it (a plain number or a $variable)."""
 
+    def branch(self, conditions: list[str]) -> int:
+        """Which branch of a script's ``if`` the engine takes now: the index of the first of its
+        conditions (as written) that holds, ``len(conditions)`` for the else."""
+
+    def jump_skipped(self) -> bool:
+        """Whether a script's ``next`` since the last call exhausted its variable, so that the
+        engine's input loop would skip the next ``jump``."""
+
+    def set_up_next(self) -> None:
+        """The next run starts with a full set-up, as a script's ``run`` (``pre yes``) does."""
+
     def run(self, steps: int) -> None:
         """Advance ``steps`` steps (0: set up only)."""
 

@@ -65,6 +65,7 @@ _HELPER_DECLARATIONS = {
     "collheat_context": (None, [_cp]),
     "collheat_flush": (None, [_vp]),
     "collheat_trial_output": (_int, [_vp, _cp]),
+    "collheat_take_jump_skip": (_int, [_vp]),
     "collheat_compute_local": (_int, [_vp, _cp, _c.POINTER(_int), _c.POINTER(_int),
                                       _c.POINTER(_c.POINTER(_c.c_double))]),
     "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
@@ -300,6 +301,11 @@ class Liggghts:
         self._execute(str(path), LiggghtsError, is_file=True)
         self._changed = self._new = True
 
+    def set_up_next(self) -> None:
+        """The next run starts with a full set-up (a script's ``run``, whose default ``pre yes``
+        recomputes the forces from a fresh neighbour list, as plain LIGGGHTS does at each run)."""
+        self._changed = True
+
     def keep_set_up(self) -> None:
         """The next run starts without a set-up, whatever came since the last one (the caller
         put back what a set-up would recompute: a checkpoint's forces)."""
@@ -442,6 +448,11 @@ class Liggghts:
         """Time step (s)."""
         return ctypes.cast(self.lib.lammps_extract_global(self.ptr, b"dt"),
                            ctypes.POINTER(ctypes.c_double))[0]
+
+    def take_jump_skip(self) -> bool:
+        """Whether a ``next`` since the last call exhausted its variable, so that LIGGGHTS would
+        skip the next ``jump`` (plugins/liggghts/input_loop.cpp); the flag is cleared."""
+        return bool(self.helper.collheat_take_jump_skip(self.ptr))
 
     def variable(self, name: str) -> float:
         """Value of an equal-style variable."""

@@ -221,6 +221,9 @@ class Follower:
         except LiggghtsFailed:
             pass                  # rank 0 has the same error and reports it; orders go on
 
+    def do_set_up_next(self) -> None:
+        self.lmp.set_up_next()
+
     def do_variable(self, name) -> None:
         self.lmp.variable(name)
 

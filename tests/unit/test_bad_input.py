@@ -53,10 +53,12 @@ def test_cli_bad_input_one_line_exit_2(args, word):
 
 
 @pytest.mark.parametrize("line, message", [
-    ('if "${a} > 1" then "run 200"', "'run' inside 'if': the host couples every run itself"),
+    ("jump SELF ${where}", "a jump to a file or label given as a variable is not supported"),
+    ("jump in.missing", "'jump in.missing': no script"),
+    ('if "${a} > 1" then', "'if' needs a condition, 'then' and a command"),
     ('if "${a} > 1" then "print hi" else "shell cd post"', "'shell cd': it would move the host's own working folder"),
     ("shell cd post", "'shell cd': it would move the host's own working folder"),
-    ("run 100 every 10 \"print x\"", "'run ... every' is not supported by the host"),
+    ("run 100 upto every 10 \"print x\"", "'run ... upto ... every' is not supported by the host"),
     ("delete_atoms region out", "'delete_atoms' renumbers the remaining atoms' ids .* add 'compress no'"),
     ("delete_atoms region out compress yes", "'delete_atoms' renumbers"),
     ("units cgs", "'units cgs': the host's contact models, heat and energy balance are in SI"),
@@ -65,8 +67,7 @@ def test_cli_bad_input_one_line_exit_2(args, word):
      "fix particletemplate/multisphere: rigid clumps"),
 ])
 def test_script_commands_the_host_cannot_couple_are_refused_when_read(tmp_path, line, message):
-    """Found when the script is read, before any engine time, wherever they stand (an 'if'
-    used to run 200 uncoupled steps; 'run ... every' was refused only when reached)."""
+    """Found when the script is read, before any engine time, wherever they stand."""
     from pyhost.script import ScriptError, read_script
 
     (tmp_path / "in.x").write_text(f"variable a equal 2\nrun 10\n{line}\n")

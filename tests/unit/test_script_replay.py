@@ -61,12 +61,36 @@ def test_the_box_becomes_the_checkpoints_restart_and_what_it_holds_is_left_out(c
     assert out[4].line == 5          # the read_restart stands at the script's create_box line
 
 
-def test_an_if_before_the_interrupted_run_is_refused_naming_its_line(tmp_path):
-    (tmp_path / "in.if").write_text(SCRIPT.replace('print "pouring"', 'if "${n} > 10" then "set group all vx 1"'))
-    commands = read_script(tmp_path / "in.if")
-    at = next(k for k, c in enumerate(commands) if c.text == "run 200")
-    with pytest.raises(ScriptError, match=r"in.if:14: an 'if' before the interrupted run"):
-        replay(commands, at, Path("x"))
+def test_program_follows_loops_jumps_and_includes_as_liggghts_input_loop(tmp_path):
+    """LIGGGHTS' input loop without the engine: 'next' is the caller's (here: its variable is
+    exhausted at the third pass, which skips one jump), an include is read in its place, a
+    jump inside an 'if' branch drops the branch's other commands, a missing label is named;
+    state() and restore() carry the position and the trace."""
+    from pyhost.script import Program
+
+    (tmp_path / "in.inc").write_text("print inc\n")
+    (tmp_path / "in.loop").write_text("variable i loop 3\nlabel top\nrun 10\nnext i\njump SELF top\n"
+                                      "include in.inc\nif x then y\nrun 1\nlabel out\nrun 2\njump SELF nowhere\n")
+    p = Program(tmp_path / "in.loop", tmp_path)
+    taken, passes = [], 0
+    while (cmd := p.take()) is not None:
+        taken.append(cmd.text)
+        p.trace.append(cmd)
+        if cmd.name == "next":
+            passes += 1
+            p.skip_jump = passes == 3
+        if cmd.name == "if":
+            p.push(cmd, ["print a", "jump SELF out", "print never"])
+            state = p.state()
+        if cmd.text == "run 2":
+            break
+    assert taken == ["variable i loop 3", "run 10", "next i", "run 10", "next i", "run 10", "next i", "print inc",
+                     "if x then y", "print a", "run 2"]
+    again = Program.restore(state, tmp_path)
+    assert [c.text for c in again.trace] == taken[:-2]
+    assert again.take().text == "print a" and again.take().text == "run 2"
+    with pytest.raises(ScriptError, match=r"in.loop:11: 'jump SELF nowhere': no 'label nowhere'"):
+        again.take()
 
 
 def test_a_script_without_a_box_before_the_run_is_refused(tmp_path):
