@@ -276,7 +276,7 @@ class Coupling:
             effect.flush()
         values = dict(t0_step=self.t0_step, steps=self.steps, t=self.t, totals=self.totals, warned=sorted(self.warned),
                       command=self.command, run_left=self.run_left, mesh_motion=self.dem.mesh_motion_times(),
-                      randoms=self.dem.random_states())
+                      randoms=self.dem.random_states(), insertions=self.dem.insertion_progress())
         arrays, logs = {}, {}
         for effect in self.effect_list:
             v, a = effect.state()
@@ -295,6 +295,7 @@ class Coupling:
         checkpoint.restore_forces(self.dem, state)
         self.dem.set_mesh_motion_times(state.get("mesh_motion", {}))
         self.dem.set_random_states(state.get("randoms", {}))
+        self.dem.set_insertion_progress(state.get("insertions", {}))
         for effect in self.effect_list:
             effect.restore(state)
 

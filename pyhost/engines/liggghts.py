@@ -70,6 +70,7 @@ _HELPER_DECLARATIONS = {
     "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
     "collheat_move_mesh_time": (_int, [_vp, _cp, _c.POINTER(_c.c_double), _int]),
     "collheat_random_state": (_int, [_vp, _cp, _cp, _c.POINTER(_int), _int]),
+    "collheat_insert_progress": (_int, [_vp, _cp, _c.POINTER(_c.c_double), _int]),
     "collheat_keep_mesh_bins": (_int, [_vp]),
     "collheat_dump_every": (_int, [_vp]),
     "collheat_unit_style": (_cp, [_vp]),
@@ -526,6 +527,16 @@ class Liggghts:
                                              int(value is not None)):
             return None
         return s.value
+
+    def insert_progress(self, id_: str, value: list | None = None) -> list | None:
+        """The progress of ``fix <id_> insert/*`` (None: there is none): [the step of its next
+        insertion (0: none more), particles inserted so far, their mass in kg, the step of its first
+        insertion, that of its most recent (-1: none)]; with ``value``, set it first. LIGGGHTS'
+        restart loses a finished insertion's 'none more' (see plugins/liggghts/restart_state.cpp)."""
+        state = (ctypes.c_double * 5)(*(value or [0.0] * 5))
+        if self.helper.collheat_insert_progress(self.ptr, id_.encode(), state, int(value is not None)):
+            return None
+        return list(state)
 
     # -- contacts ---------------------------------------------------------------------
     def add_pair_contacts(self, compute_id: str = "pairs") -> None:
