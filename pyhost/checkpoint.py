@@ -70,6 +70,29 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
+def fingerprints(scene, commands) -> dict:
+    """SHA-256 of every file the run reads, by absolute path, taken when it starts: a user's
+    script, the files it includes and those its commands read (STL meshes, data and restart
+    files: ``pyhost.script.input_files``), and the dictionaries, mesh and starting fields of
+    the user's OpenFOAM case (its system/, constant/ and start time folder). A restart refuses
+    to go on if one changed since (``load``). A box scene's generated script is the host's own:
+    its case.toml has its fingerprint of its own."""
+    from pyhost.script import input_files
+
+    files = []
+    if scene.scripted:
+        files += [Path(f).resolve() for f in dict.fromkeys(c.file for c in commands if c.file != "(host)")]
+        files += input_files(commands, scene.folder)
+    if scene.effects.fluid and scene.fluid.case:
+        from pyhost.engines.fluid_case import start_time
+
+        case = (scene.folder / scene.fluid.case).resolve()
+        start = start_time(case)[1]
+        for sub in ("system", "constant", *([start] if start else [])):
+            files += sorted(p for p in (case / sub).rglob("*") if p.is_file())
+    return {str(p): _sha256(p) for p in dict.fromkeys(files)}
+
+
 def write(coupling) -> Path:
     """A checkpoint of ``coupling`` (a ``pyhost.loop.Coupling`` at the end of a step) into
     OUT/checkpoint; returns its folder."""
@@ -93,7 +116,7 @@ def write(coupling) -> Path:
                     code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
                     extend=coupling.extend,
                     files={name: _sha256(new / name) for name in files},
-                    inputs={str(f): _sha256(Path(f)) for f in coupling.inputs})
+                    inputs=coupling.inputs)
     write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
     shutil.rmtree(old, ignore_errors=True)
     if final.exists():
@@ -169,8 +192,10 @@ def load(out: Path, scene, extend: float = 0.0) -> dict:
     needed = set(FILES) | ({f"{FLUID}/host.npz"} if scene.effects.fluid else set())
     for name, sha in (manifest.get("inputs") or {}).items():
         if not Path(name).is_file() or _sha256(Path(name)) != sha:
-            raise UserError(f"--restart: {name} is not the script the checkpoint's run read (changed or gone since): "
-                            "a restart replays the script as it was")
+            raise UserError(f"--restart: {name} is not the file the checkpoint's run read ("
+                            f"{'changed' if Path(name).is_file() else 'gone'} since it started: its SHA-256 then is "
+                            "in the checkpoint's manifest.json): a restart continues the run with the inputs it "
+                            "read; put the file back, or start the run anew with --overwrite")
     for name in sorted(needed | set(manifest["files"])):
         path = folder / name
         if not path.is_file():

@@ -143,7 +143,7 @@ class Coupling:
         if events:                           # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
         self.command, self.run_left = -1, 0  # the script's run under way (its index) and its steps to go
-        self.inputs = ()                     # the script's files (a restart checks them)
+        self.inputs = {}                     # SHA-256 of each file the run read, at its start (a restart checks them)
         self.extend = 0.0                    # run --extend [s] (a checkpoint keeps it)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
         self.resumed = resume is not None    # the next advance continues the checkpoint's run
@@ -332,7 +332,7 @@ class Coupling:
 
 def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end: float | None = None,
               max_time: float | None = None, driven: float | None = None, extend: float = 0.0,
-              progress_every: float = 5.0, log=print, **particles) -> dict:
+              progress_every: float = 5.0, log=print, inputs: dict | None = None, **particles) -> dict:
     """Run a script's commands on ``dem``; each ``run N`` is N coupled steps (steps beyond
     ``max_time`` [s] of coupled time, for smoke runs, are cut). ``driven`` [s]: how long the
     script's last ``run`` lasts when it asks for 0 steps (a CFD-DEM script whose coupling
@@ -340,7 +340,8 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     last run's own steps come first, as CFDEM runs them before its coupling. ``extend`` [s]: how
     much longer than written the script's last run goes on (``run --extend``, a restart's; a box
     scene's end comes extended). With ``output.checkpoint`` a completed run ends in a
-    checkpoint, from which ``--extend`` goes on. ``walls_of(dem)`` gives the HostWalls once the
+    checkpoint, from which ``--extend`` goes on; ``inputs``: the SHA-256 of each file the run
+    reads, taken at its start (``checkpoint.fingerprints``), which its checkpoints keep. ``walls_of(dem)`` gives the HostWalls once the
     script's walls exist; ``particles``: type_material, known and resume of ``Coupling``.
     Returns the summary, also written when a step fails; a script whose runs simulate no step
     at all is refused (ScriptError) rather than ending as done."""
@@ -404,8 +405,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
                     dem.run(0)              # the checkpoint's forces go back (Coupling's restore)
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, driven=driven, **particles)
-                if scene.scripted:           # a restart replays them: checked unchanged
-                    coupling.inputs = tuple(sorted({c.file for c in commands if c.file != "(host)"}))
+                coupling.inputs = inputs or {}
                 coupling.extend = extend
                 coupling.start()
             else:

@@ -372,8 +372,55 @@ def test_restart_of_an_edited_script_is_refused(tmp_path, capsys):
     script.write_text(script.read_text().replace("vel constant 0. 0. -0.3 set_property Temp 400.",
                                                  "vel constant 0. 0. -0.5 set_property Temp 400."))
     before = fingerprint(out / "checkpoint")
-    assert "in.liggghts is not the script the checkpoint's run read" in refused(
+    assert "in.liggghts is not the file the checkpoint's run read (changed since it started" in refused(
         capsys, "run", folder, "--test", "--out", out, "--restart")
+    assert fingerprint(out / "checkpoint") == before
+
+
+# two beads resting on the floor, read by 'read_data beads.data' in place of create_box
+BEADS = """LIGGGHTS data file: two beads of 2 mm
+
+2 atoms
+1 atom types
+
+-0.01 0.01 xlo xhi
+-0.01 0.01 ylo yhi
+0 0.03 zlo zhi
+
+Atoms
+
+1 1 0.002 2500 0 0 0.001
+2 1 0.002 2500 0.004 0 0.001
+"""
+
+
+def moved_down_4_mm(path: Path) -> None:
+    path.write_text(path.read_text().replace(" 0.012\n", " 0.008\n"))
+
+
+@pytest.mark.parametrize("insertion, edit, name", [
+    ("stream", moved_down_4_mm, "face.stl"),
+    ("pack_once", lambda p: p.write_text(p.read_text().replace("0.004 0 0.001", "0.005 0 0.001")), "beads.data"),
+])
+def test_restart_after_an_input_file_changed_is_refused(tmp_path, capsys, insertion, edit, name):
+    """Every file the run read is fingerprinted (SHA-256) when it starts: an STL mesh of the
+    script's (insert/stream's face moved 4 mm down) or its read_data file (a bead moved 1 mm)
+    edited after the stop is refused at --restart (exit 2) naming the file, before any engine
+    starts, the checkpoint left as it was. (They used to be continued silently.)"""
+    folder = pour(tmp_path, insertion)
+    script = folder / "in.pour"
+    script.write_text(script.read_text().replace("create_box 1 box", "read_data beads.data"))
+    (folder / "beads.data").write_text(BEADS)
+    out = tmp_path / "out"
+    r = pyhost("run", folder, "--out", out, stop=(1403, "SIGTERM"))
+    assert r.returncode == 143, r.stderr[-2000:]
+    manifest = json.loads((out / "checkpoint" / "manifest.json").read_text())
+    read = {"in.pour", "beads.data"} | ({"face.stl"} if insertion == "stream" else set())
+    assert {Path(f).name for f in manifest["inputs"]} == read
+    edit(folder / name)
+    before = fingerprint(out / "checkpoint")
+    message = refused(capsys, "run", folder, "--out", out, "--restart")
+    assert f"{folder / name} is not the file the checkpoint's run read (changed since it started" in message
     assert fingerprint(out / "checkpoint") == before
 
 
