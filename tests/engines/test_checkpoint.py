@@ -218,6 +218,10 @@ def damage_manifest(ck, key, value):
     (lambda case, ck: (ck / "host.json").write_text("{"), "host.json is not the file written"),
     (lambda case, ck: os.truncate(ck.parent / "collisions.csv", 50), "collisions.csv: 50 bytes, where the checkpoint"),
     (lambda case, ck: edit_first_byte(ck.parent / "history.csv"), "history.csv: its bytes before the checkpoint"),
+    # the VTK folder deleted: a restart used to write a .pvd listing the frames no longer there
+    (lambda case, ck: shutil.rmtree(ck.parent / "vtk"), "vtk/particles_00000.vtu is missing (11 of the 11 frames of "
+                                                         "particles.pvd written before the checkpoint are)"),
+    (lambda case, ck: (ck.parent / "vtk" / "particles_00007.vtu").unlink(), "particles_00007.vtu is missing (1 of"),
 ])
 def test_bad_checkpoint_is_refused_and_left_as_it_was(stopped, capsys, damage, message):
     case_dir, out = stopped
