@@ -340,9 +340,10 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, fluid=None, end
     last run's own steps come first, as CFDEM runs them before its coupling. ``extend`` [s]: how
     much longer than written the script's last run goes on (``run --extend``, a restart's; a box
     scene's end comes extended). With ``output.checkpoint`` a completed run ends in a
-    checkpoint, from which ``--extend`` goes on; ``inputs``: the SHA-256 of each file the run
-    reads, taken at its start (``checkpoint.fingerprints``), which its checkpoints keep. ``walls_of(dem)`` gives the HostWalls once the
-    script's walls exist; ``particles``: type_material, known and resume of ``Coupling``.
+    checkpoint, from which ``--extend`` goes on. ``inputs``: the SHA-256 of each file the run
+    reads, taken at its start (``checkpoint.fingerprints``), which its checkpoints keep.
+    ``walls_of(dem)`` gives the HostWalls once the script's walls exist; ``particles``:
+    type_material, known and resume of ``Coupling``.
     Returns the summary, also written when a step fails; a script whose runs simulate no step
     at all is refused (ScriptError) rather than ending as done."""
     coupling = None

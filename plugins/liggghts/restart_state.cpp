@@ -19,8 +19,10 @@
 // step of its next insertion (Fix::next_reneighbor; 0 once it has inserted all it will) and what
 // it inserted so far. FixInsert::restart (fix_insert.cpp) takes the count and the mass back, but
 // keeps the next step only when it is not 0: an insertion that was done ('insert_every once',
-// or a count reached) is scheduled again at the step after the restart, so a script pouring
-// 200 particles with 'insert/pack ... insert_every once' had 300 after a restart.
+// or a count reached) is scheduled again at the step after the restart: measured, a pour of 50
+// beads by 'insert/pack ... insert_every once' had 68 after a restart, and an insert/rate/region
+// done before it stopped the restarted run at its next checkpoint ('start' step can not be
+// before current step, from the fix's init in write_restart).
 #include <cstring>
 #include "lammps.h"
 #include "modify.h"
