@@ -102,7 +102,12 @@ def write(coupling) -> Path:
     shutil.rmtree(new, ignore_errors=True)
     new.mkdir()
     try:
-        ids, f, torque, x = dem.per_atom(("id", "f", "torque", "x"))
+        # with fix insert/stream, the step each atom is released at: LIGGGHTS recomputes it on
+        # reading a restart from the atom's path (for a changed time step), which can give the
+        # step before (measured: the second lot of a stream released early, impact speeds 1e-4
+        # apart after); it goes back by id with the forces
+        streams = ("release_step",) if dem.info.streams else ()
+        ids, f, torque, x, *release = dem.per_atom(("id", "f", "torque", "x") + streams)
         ids = ids.astype(np.int64)
         if _past_the_box(dem, x):
             # particles past a fixed face of the box ('thermo_modify lost ignore'): LIGGGHTS drops
@@ -111,12 +116,12 @@ def write(coupling) -> Path:
             # host.npz: "corrupt checkpoint", exit 2, at the checkpoint after a box emptied)
             dem.engine_command("run 0 post no")
             kept = np.isin(ids, dem.per_atom(("id",))[0])
-            ids, f, torque = ids[kept], f[kept], torque[kept]
+            ids, f, torque, release = ids[kept], f[kept], torque[kept], [r[kept] for r in release]
         dem.engine_command(f"write_restart {new / RESTART}")
         dem.run(0)                                   # set up again, then the step's own forces back
         _put_forces(dem, ids, f, torque)
         values, arrays = coupling.state()
-        np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **arrays)
+        np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **dict(zip(streams, release)), **arrays)
         write_atomic(new / "host.json", json.dumps(values, indent=1))
         if coupling.fluid is not None:
             coupling.fluid.save(new / FLUID)
@@ -158,20 +163,23 @@ def mark_complete(out: Path) -> None:
     write_atomic(path, json.dumps(manifest, indent=1))
 
 
-def _put_forces(dem, ids, f, torque) -> None:
-    """Forces [N] and torques [N m] of the atoms with these ids into LIGGGHTS (on every rank)."""
+def _put_forces(dem, ids, f, torque, **more) -> None:
+    """Forces [N] and torques [N m] of the atoms with these ids into LIGGGHTS (on every rank),
+    and ``more`` per-atom values by name (``release_step``)."""
     if dem.count() != len(ids):
         raise UserError("checkpoint: the restart file's atoms are not those of host.npz (corrupt checkpoint)")
     try:
-        dem.put_per_atom(ids, f=f, torque=torque)
+        dem.put_per_atom(ids, f=f, torque=torque, **more)
     except ValueError as exc:
         raise UserError(f"checkpoint: the restart file's atoms are not those of host.npz (corrupt checkpoint): "
                         f"{exc}") from None
 
 
 def restore_forces(dem, state: dict) -> None:
-    """After the restarted DEM's set-up: the forces and torques of the checkpoint's step."""
-    _put_forces(dem, state["ids"], state["f"], state["torque"])
+    """After the restarted DEM's set-up: the forces and torques of the checkpoint's step, and
+    the release steps of fix insert/stream's atoms."""
+    _put_forces(dem, state["ids"], state["f"], state["torque"],
+                **{k: state[k] for k in ("release_step",) if k in state})
 
 
 def load(out: Path, scene, extend: float = 0.0) -> dict:

@@ -381,6 +381,7 @@ class ScriptInfo:
     globals: dict = field(default_factory=dict)         # property/global name -> fix id
     periodic: tuple = (False, False, False)             # from the boundary command
     mesh_motions: list = field(default_factory=list)    # ids of the fix move/mesh defined now
+    streams: list = field(default_factory=list)         # ids of the fix insert/stream defined now
     randoms: list = field(default_factory=list)         # "what id" of insertion's random generators
 
     def wall_type(self, fix: str, mesh: int = 0) -> int | None:
@@ -432,12 +433,16 @@ class ScriptInfo:
                 self.globals[w[4]] = w[1]
             elif style.startswith("move/mesh") and w[1] not in self.mesh_motions:
                 self.mesh_motions.append(w[1])
+            elif style == "insert/stream" and w[1] not in self.streams:
+                self.streams.append(w[1])
             for what in RANDOMS.get(style.split("/")[0] if style.startswith("insert/") else style, ()):
                 self._random(f"{what} {w[1]}", True)
         elif w[0] == "unfix" and len(w) == 2:
             self.walls.pop(w[1], None)
             if w[1] in self.mesh_motions:
                 self.mesh_motions.remove(w[1])
+            if w[1] in self.streams:
+                self.streams.remove(w[1])
             self.randoms = [k for k in self.randoms if k.split(" ", 1)[1] != w[1] or k.startswith("region ")]
             if self.heat_gran == w[1]:
                 self.heat_gran = None

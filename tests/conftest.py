@@ -254,10 +254,10 @@ INSERTIONS = {
     # 60 in two lots of 30 (steps 1 and 501): done before the checkpoint
     "rate": "fix ins all insert/rate/region seed 32452843 distributiontemplate pdd nparticles 60 particlerate 6000 "
             "insert_every 500 overlapcheck yes all_in yes vel constant 0 0 -0.5 region fill",
-    # 40 through the face in one lot at step 1, released at step 801 (a stream still in its
-    # extrusion at the checkpoint: docs/checkpoint.md)
+    # 60 through the face, in lots of 48 (step 1) and 12 (step 801, released by step 1601: some
+    # still in their extrusion at the checkpoint, step 1500)
     "stream": "fix inface all mesh/surface file face.stl type 1\nfix ins all insert/stream seed 32452843 "
-              "distributiontemplate pdd nparticles 40 particlerate 6000 overlapcheck yes vel constant 0 0 -0.5 "
+              "distributiontemplate pdd nparticles 60 particlerate 6000 overlapcheck yes vel constant 0 0 -0.5 "
               "insertion_face inface extrude_length 0.004",
 }
 
