@@ -70,6 +70,29 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
+def fingerprints(scene, commands) -> dict:
+    """SHA-256 of every file the run reads, by absolute path, taken when it starts: a user's
+    script, the files it includes and those its commands read (STL meshes, data and restart
+    files: ``pyhost.script.input_files``), and the dictionaries, mesh and starting fields of
+    the user's OpenFOAM case (its system/, constant/ and start time folder). A restart refuses
+    to go on if one changed since (``load``). A box scene's generated script is the host's own:
+    its case.toml has its fingerprint of its own."""
+    from pyhost.script import input_files
+
+    files = []
+    if scene.scripted:
+        files += [Path(f).resolve() for f in dict.fromkeys(c.file for c in commands if c.file != "(host)")]
+        files += input_files(commands, scene.folder)
+    if scene.effects.fluid and scene.fluid.case:
+        from pyhost.engines.fluid_case import start_time
+
+        case = (scene.folder / scene.fluid.case).resolve()
+        start = start_time(case)[1]
+        for sub in ("system", "constant", *([start] if start else [])):
+            files += sorted(p for p in (case / sub).rglob("*") if p.is_file())
+    return {str(p): _sha256(p) for p in dict.fromkeys(files)}
+
+
 def write(coupling) -> Path:
     """A checkpoint of ``coupling`` (a ``pyhost.loop.Coupling`` at the end of a step) into
     OUT/checkpoint; returns its folder."""
@@ -78,22 +101,39 @@ def write(coupling) -> Path:
     final, new, old = out / FOLDER, out / ".checkpoint.new", out / ".checkpoint.old"
     shutil.rmtree(new, ignore_errors=True)
     new.mkdir()
-    ids, f, torque = dem.per_atom(("id", "f", "torque"))
-    ids = ids.astype(np.int64)
-    dem.engine_command(f"write_restart {new / RESTART}")
-    dem.run(0)                                   # set up again, then the step's own forces back
-    _put_forces(dem, ids, f, torque)
-    values, arrays = coupling.state()
-    np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **arrays)
-    write_atomic(new / "host.json", json.dumps(values, indent=1))
-    if coupling.fluid is not None:
-        coupling.fluid.save(new / FLUID)
+    try:
+        # with fix insert/stream, the step each atom is released at: LIGGGHTS recomputes it on
+        # reading a restart from the atom's path (for a changed time step), which can give the
+        # step before (measured: the second lot of a stream released early, impact speeds 1e-4
+        # apart after); it goes back by id with the forces
+        streams = ("release_step",) if dem.info.streams else ()
+        ids, f, torque, x, *release = dem.per_atom(("id", "f", "torque", "x") + streams)
+        ids = ids.astype(np.int64)
+        if _past_the_box(dem, x):
+            # particles past a fixed face of the box ('thermo_modify lost ignore'): LIGGGHTS drops
+            # them at its next re-neighbouring, which the set-up after write_restart is; a set-up
+            # first drops them from the restart file too (they used to stay in it and not in
+            # host.npz: "corrupt checkpoint", exit 2, at the checkpoint after a box emptied)
+            dem.engine_command("run 0 post no")
+            kept = np.isin(ids, dem.per_atom(("id",))[0])
+            ids, f, torque, release = ids[kept], f[kept], torque[kept], [r[kept] for r in release]
+        dem.engine_command(f"write_restart {new / RESTART}")
+        dem.run(0)                                   # set up again, then the step's own forces back
+        _put_forces(dem, ids, f, torque)
+        values, arrays = coupling.state()
+        np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **dict(zip(streams, release)), **arrays)
+        write_atomic(new / "host.json", json.dumps(values, indent=1))
+        if coupling.fluid is not None:
+            coupling.fluid.save(new / FLUID)
+    except BaseException:
+        shutil.rmtree(new, ignore_errors=True)      # no half-written checkpoint left beside the last good one
+        raise
     files = sorted(str(p.relative_to(new)) for p in new.rglob("*") if p.is_file())
     manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
                     code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
                     extend=coupling.extend,
                     files={name: _sha256(new / name) for name in files},
-                    inputs={str(f): _sha256(Path(f)) for f in coupling.inputs})
+                    inputs=coupling.inputs)
     write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
     shutil.rmtree(old, ignore_errors=True)
     if final.exists():
@@ -107,6 +147,13 @@ def write(coupling) -> Path:
     return final
 
 
+def _past_the_box(dem, x) -> bool:
+    """Whether a particle at ``x`` [m] lies beyond the box in a direction that is not periodic."""
+    lo, hi, periodic = dem.box()
+    out = (x < lo) | (x > hi)
+    return bool(out[:, ~np.asarray(periodic, bool)].any())
+
+
 def mark_complete(out: Path) -> None:
     """The checkpoint in OUT/checkpoint, written at the last step of a completed run, marked so
     (``complete`` in its manifest): a restart from it needs ``--extend``."""
@@ -116,20 +163,23 @@ def mark_complete(out: Path) -> None:
     write_atomic(path, json.dumps(manifest, indent=1))
 
 
-def _put_forces(dem, ids, f, torque) -> None:
-    """Forces [N] and torques [N m] of the atoms with these ids into LIGGGHTS (on every rank)."""
+def _put_forces(dem, ids, f, torque, **more) -> None:
+    """Forces [N] and torques [N m] of the atoms with these ids into LIGGGHTS (on every rank),
+    and ``more`` per-atom values by name (``release_step``)."""
     if dem.count() != len(ids):
         raise UserError("checkpoint: the restart file's atoms are not those of host.npz (corrupt checkpoint)")
     try:
-        dem.put_per_atom(ids, f=f, torque=torque)
+        dem.put_per_atom(ids, f=f, torque=torque, **more)
     except ValueError as exc:
         raise UserError(f"checkpoint: the restart file's atoms are not those of host.npz (corrupt checkpoint): "
                         f"{exc}") from None
 
 
 def restore_forces(dem, state: dict) -> None:
-    """After the restarted DEM's set-up: the forces and torques of the checkpoint's step."""
-    _put_forces(dem, state["ids"], state["f"], state["torque"])
+    """After the restarted DEM's set-up: the forces and torques of the checkpoint's step, and
+    the release steps of fix insert/stream's atoms."""
+    _put_forces(dem, state["ids"], state["f"], state["torque"],
+                **{k: state[k] for k in ("release_step",) if k in state})
 
 
 def load(out: Path, scene, extend: float = 0.0) -> dict:
@@ -169,8 +219,10 @@ def load(out: Path, scene, extend: float = 0.0) -> dict:
     needed = set(FILES) | ({f"{FLUID}/host.npz"} if scene.effects.fluid else set())
     for name, sha in (manifest.get("inputs") or {}).items():
         if not Path(name).is_file() or _sha256(Path(name)) != sha:
-            raise UserError(f"--restart: {name} is not the script the checkpoint's run read (changed or gone since): "
-                            "a restart replays the script as it was")
+            raise UserError(f"--restart: {name} is not the file the checkpoint's run read ("
+                            f"{'changed' if Path(name).is_file() else 'gone'} since it started: its SHA-256 then is "
+                            "in the checkpoint's manifest.json): a restart continues the run with the inputs it "
+                            "read; put the file back, or start the run anew with --overwrite")
     for name in sorted(needed | set(manifest["files"])):
         path = folder / name
         if not path.is_file():

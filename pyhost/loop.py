@@ -145,7 +145,7 @@ class Coupling:
         if events:                           # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
         self.program, self.run_left = {}, 0  # where the script stands at the run under way (Program.state), its steps to go
-        self.inputs = ()                     # the script's files (a restart checks them)
+        self.inputs = {}                     # SHA-256 of each file the run read, at its start (a restart checks them)
         self.extend = 0.0                    # run --extend [s] (a checkpoint keeps it)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
         self.resumed = resume is not None    # the next advance continues the checkpoint's run
@@ -289,9 +289,10 @@ class Coupling:
         effect's."""
         for effect in self.effect_list:    # every frame a log names on disk
             effect.flush()
-        values = dict(clock=self.clock, t_step=self.t_step, t_begin=self.t_begin, steps=self.steps, t=self.t, totals=self.totals, warned=sorted(self.warned),
-                      program=self.program, run_left=self.run_left, mesh_motion=self.dem.mesh_motion_times(),
-                      randoms=self.dem.random_states())
+        values = dict(clock=self.clock, t_step=self.t_step, t_begin=self.t_begin, steps=self.steps, t=self.t,
+                      totals=self.totals, warned=sorted(self.warned), program=self.program, run_left=self.run_left,
+                      mesh_motion=self.dem.mesh_motion_times(), randoms=self.dem.random_states(),
+                      insertions=self.dem.insertion_progress())
         arrays, logs = {}, {}
         for effect in self.effect_list:
             v, a = effect.state()
@@ -311,6 +312,7 @@ class Coupling:
         checkpoint.restore_forces(self.dem, state)
         self.dem.set_mesh_motion_times(state.get("mesh_motion", {}))
         self.dem.set_random_states(state.get("randoms", {}))
+        self.dem.set_insertion_progress(state.get("insertions", {}))
         for effect in self.effect_list:
             effect.restore(state)
 
@@ -347,7 +349,7 @@ class Coupling:
 
 def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, fluid=None, end: float | None = None,
               max_time: float | None = None, driven: float | None = None, extend: float = 0.0,
-              progress_every: float = 5.0, log=print, **particles) -> dict:
+              progress_every: float = 5.0, log=print, inputs: dict | None = None, **particles) -> dict:
     """Run the script ``script`` on ``dem`` as LIGGGHTS' input loop runs it (``Program``: includes,
     labels and jumps, loops with ``next``, ``if`` branches and ``run ... every``, ``quit``);
     ``commands`` are its commands as read and checked (``read_script``). Each ``run N`` is N
@@ -358,7 +360,9 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, f
     ``extend`` [s]: how much longer than written the script's last run goes on (``run
     --extend``, a restart's; a box scene's end comes extended). The last run is the script's
     last ``run`` command when no ``jump`` follows it. With ``output.checkpoint`` a completed run
-    ends in a checkpoint, from which ``--extend`` goes on. ``walls_of(dem)`` gives the HostWalls
+    ends in a checkpoint, from which ``--extend`` goes on. ``inputs``: the SHA-256 of each file
+    the run reads, taken at its start (``checkpoint.fingerprints``), which its checkpoints keep.
+    ``walls_of(dem)`` gives the HostWalls
     once the script's walls exist; ``particles``: type_material, known and resume of
     ``Coupling``. Returns the summary, also written when a step fails; a script whose runs
     simulate no step at all is refused (ScriptError) rather than ending as done."""
@@ -483,10 +487,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, f
                     dem.run(0)              # the checkpoint's forces go back (Coupling's restore)
                 coupling = Coupling(scene, dem, out, walls=walls_of(dem), fluid=fluid, end=end,
                                     progress_every=progress_every, driven=driven, **particles)
-                if scene.scripted:           # a restart replays them: checked unchanged
-                    jumped = {str(Path(scene.folder) / c.words[1]) for c in commands
-                              if c.name == "jump" and c.words[1] != "SELF"}
-                    coupling.inputs = tuple(sorted({c.file for c in commands if c.file != "(host)"} | jumped))
+                coupling.inputs = inputs or {}
                 coupling.extend = extend
                 coupling.start()
             else:

@@ -63,9 +63,9 @@ def check_resume(path: Path, size: int, digest: str | None) -> None:
 
 def check_logs(out: Path, logs: dict) -> None:
     """Every log of a run's output folder against its mark at a checkpoint (``mark()`` of
-    CsvLog or ColumnLog, as the checkpoint's state keeps them), before anything is cut:
-    ValueError naming the first that is missing, shorter or changed. Bare sizes of older
-    checkpoints are checked for length only."""
+    CsvLog or ColumnLog, as the checkpoint's state keeps them), and every VTK frame the
+    checkpoint's series lists, before anything is cut: ValueError naming the first that is
+    missing, shorter or changed. Bare sizes of older checkpoints are checked for length only."""
     out = Path(out)
     for name in ("collisions", "history"):
         mark = logs.get(name)
@@ -77,6 +77,13 @@ def check_logs(out: Path, logs: dict) -> None:
         elif mark is not None:
             size, tail = (mark["size"], mark["tail"]) if isinstance(mark, dict) else (int(mark), None)
             check_resume(out / f"{name}.csv", size, tail)
+    for name in ("particles", "fluid"):      # the VTK series: the frames its .pvd will list again
+        frames = logs.get(name) or []
+        missing = [f for _, f in frames if not (out / "vtk" / f).is_file()]
+        if missing:
+            raise ValueError(f"{out / 'vtk' / missing[0]} is missing ({len(missing)} of the {len(frames)} frames of "
+                             f"{name}.pvd written before the checkpoint are): the restart would list frames that "
+                             "are not there; put them back, or run the case anew with --overwrite")
 
 
 class CsvLog:

@@ -453,6 +453,43 @@ def output_files(cmd: Command) -> list[str]:
     return [w[k] for k in at if k < len(w)]
 
 
+WRITES = {"dump", "dump_modify", "undump", "write_restart", "write_data", "write_dump", "log", "restart", "print"}
+"""Commands whose file names are the run's output, not its input."""
+
+
+def input_files(commands: list[Command], folder: str | Path) -> list[Path]:
+    """The files a script's commands read, besides the script and its includes: each word that
+    names an existing file (relative to ``folder``, where the script runs), such as an STL of
+    ``fix mesh/surface file``, a ``read_data`` or ``read_restart`` file. A file the script
+    itself writes (a dump, a restart, a fix's output file) is output, not input, even where a
+    later command reads it; words with an unresolved ``$`` variable are left out."""
+    folder = Path(folder)
+    written, found = set(), []
+    for cmd in commands:
+        try:
+            words = cmd.words
+        except ValueError:
+            continue                    # unbalanced quotes: LIGGGHTS says so itself
+        if cmd.name in WRITES:
+            written.update(words[1:])
+        elif cmd.name == "fix" and not (len(words) > 3 and words[3].startswith("mesh/")):
+            written.update(output_files(cmd))       # (a mesh's 'file' is its STL: read)
+    for cmd in commands:
+        if cmd.name in WRITES or cmd.file == "(host)":
+            continue
+        try:
+            words = cmd.words
+        except ValueError:
+            continue
+        for word in words[1:]:
+            if "$" in word or word in written:
+                continue
+            path = (folder / word).resolve()
+            if path.is_file() and path not in found:
+                found.append(path)
+    return found
+
+
 def _keyword(words: list[str], name: str) -> str | None:
     """The word after keyword ``name`` of a fix command (its 5th word on), or None."""
     at = [k for k in range(4, len(words) - 1) if words[k] == name]
@@ -526,6 +563,7 @@ class ScriptInfo:
     globals: dict = field(default_factory=dict)         # property/global name -> fix id
     periodic: tuple = (False, False, False)             # from the boundary command
     mesh_motions: list = field(default_factory=list)    # ids of the fix move/mesh defined now
+    streams: list = field(default_factory=list)         # ids of the fix insert/stream defined now
     randoms: list = field(default_factory=list)         # "what id" of insertion's random generators
 
     def wall_type(self, fix: str, mesh: int = 0) -> int | None:
@@ -577,12 +615,16 @@ class ScriptInfo:
                 self.globals[w[4]] = w[1]
             elif style.startswith("move/mesh") and w[1] not in self.mesh_motions:
                 self.mesh_motions.append(w[1])
+            elif style == "insert/stream" and w[1] not in self.streams:
+                self.streams.append(w[1])
             for what in RANDOMS.get(style.split("/")[0] if style.startswith("insert/") else style, ()):
                 self._random(f"{what} {w[1]}", True)
         elif w[0] == "unfix" and len(w) == 2:
             self.walls.pop(w[1], None)
             if w[1] in self.mesh_motions:
                 self.mesh_motions.remove(w[1])
+            if w[1] in self.streams:
+                self.streams.remove(w[1])
             self.randoms = [k for k in self.randoms if k.split(" ", 1)[1] != w[1] or k.startswith("region ")]
             if self.heat_gran == w[1]:
                 self.heat_gran = None

@@ -253,6 +253,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     than the scene asks a script's last run goes on (``run --extend``; a box scene comes with its
     end extended); ``link``: the other MPI ranks' LIGGGHTS (``pyhost.engines.ranks``), None when
     serial. Returns the summary."""
+    from pyhost.checkpoint import fingerprints
     from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
     from pyhost.loop import run_scene
@@ -277,6 +278,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     commands = read_script(script, scene.folder)
     if scene.scripted:
         check_types(commands, scene.materials, str(scene.path))
+    inputs = fingerprints(scene, commands)      # at the start: a restart checks that none changed since
     fluid = start_fluid(scene, out / "fluid", resume and resume["fluid"]) if effects["fluid_solver"] else None
     cwd = os.getcwd()
     try:
@@ -286,7 +288,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
             return run_scene(scene, wrap(dem) if wrap else dem, commands, out, script=script, max_time=max_time,
                              fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
                              end=None if scene.scripted else scene.time.end, driven=driven, extend=extend,
-                             progress_every=progress_every,
+                             progress_every=progress_every, inputs=inputs,
                              **particles)
         finally:
             dem.close()

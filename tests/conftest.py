@@ -195,3 +195,78 @@ heat_capacity = 840.0
 conductivity = 1.0
 {dem}
 """
+
+
+# A small pour (the smallest that shows an insertion restarted): glass beads of 1 mm inserted
+# into a 16 mm cylinder over a floor at 400 K, 3000 steps of 1e-5 s, a checkpoint at 0.015 s.
+POUR = """atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+region box block -0.01 0.01 -0.01 0.01 0 0.03 units box
+create_box 1 box
+neighbor 0.0005 bin
+neigh_modify delay 0
+fix m1 all property/global youngsModulus peratomtype 5e6
+fix m2 all property/global poissonsRatio peratomtype 0.3
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5
+fix m4 all property/global coefficientFriction peratomtypepair 1 0.5
+pair_style gran model hertz tangential history
+pair_coeff * *
+timestep 1e-5
+fix gravi all gravity 9.81 vector 0 0 -1
+fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+fix sides all wall/gran model hertz tangential history primitive type 1 zcylinder 0.008 0 0
+fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
+fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+region fill cylinder z 0 0 0.007 0.002 0.02 units box
+{insert}
+fix integr all nve/sphere
+run 3000
+"""
+POUR_TOML = f"""[dem]
+script = "in.pour"
+[effects]
+contact_heat = "A"
+{glass_toml()}[[walls]]
+fix = "floor"
+material = "glass"
+temperature = 400.0
+[output]
+vtk = false
+pictures = false
+checkpoint = 0.015
+"""
+# a square insertion face of 10 mm at z = 12 mm, for insert/stream
+FACE = "solid face\n" + "".join(
+    f"facet normal 0 0 -1\nouter loop\n" + "".join(f"vertex {x} {y} 0.012\n" for x, y in tri) + "endloop\nendfacet\n"
+    for tri in (((-0.005, -0.005), (0.005, -0.005), (0.005, 0.005)), ((-0.005, -0.005), (0.005, 0.005), (-0.005, 0.005)))
+) + "endsolid face\n"
+INSERTIONS = {
+    # inserts 50 at step 1, then never again
+    "pack_once": "fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 -0.5 "
+                 "insert_every once overlapcheck yes all_in yes particles_in_region 50 region fill",
+    # tops the region up to 30 at steps 1, 1001, 2001
+    "pack_every": "fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 -0.5 "
+                  "insert_every 1000 overlapcheck yes all_in yes particles_in_region 30 region fill",
+    # 60 in two lots of 30 (steps 1 and 501): done before the checkpoint
+    "rate": "fix ins all insert/rate/region seed 32452843 distributiontemplate pdd nparticles 60 particlerate 6000 "
+            "insert_every 500 overlapcheck yes all_in yes vel constant 0 0 -0.5 region fill",
+    # 60 through the face, in lots of 48 (step 1) and 12 (step 801, released by step 1601: some
+    # still in their extrusion at the checkpoint, step 1500)
+    "stream": "fix inface all mesh/surface file face.stl type 1\nfix ins all insert/stream seed 32452843 "
+              "distributiontemplate pdd nparticles 60 particlerate 6000 overlapcheck yes vel constant 0 0 -0.5 "
+              "insertion_face inface extrude_length 0.004",
+}
+
+
+def pour(tmp, insertion: str):
+    """A case folder in ``tmp`` of the pour with the insertion ``INSERTIONS[insertion]``."""
+    folder = tmp / f"pour-{insertion}"
+    folder.mkdir(parents=True)
+    (folder / "in.pour").write_text(POUR.format(insert=INSERTIONS[insertion]))
+    (folder / "face.stl").write_text(FACE)
+    (folder / "case.toml").write_text(POUR_TOML)
+    return folder

@@ -14,6 +14,15 @@
 // insertion's own state, not to where the region's stream was, and not every template
 // generator is kept: on cases/silo-heat the first insertion after a restart put its particles
 // elsewhere than the run never stopped. The members are protected.
+//
+// the progress of each insertion fix (fix insert/pack, insert/stream, insert/rate/region): the
+// step of its next insertion (Fix::next_reneighbor; 0 once it has inserted all it will) and what
+// it inserted so far. FixInsert::restart (fix_insert.cpp) takes the count and the mass back, but
+// keeps the next step only when it is not 0: an insertion that was done ('insert_every once',
+// or a count reached) is scheduled again at the step after the restart: measured, a pour of 50
+// beads by 'insert/pack ... insert_every once' had 68 after a restart, and an insert/rate/region
+// done before it stopped the restarted run at its next checkpoint ('start' step can not be
+// before current step, from the fix's init in write_restart).
 #include <cstring>
 #include "lammps.h"
 #include "modify.h"
@@ -79,6 +88,32 @@ int collheat_random_state(void *ptr, const char *what, const char *id, int *stat
     if (random == NULL) return -1;
     if (set) random->reset(*state);
     else *state = random->state();
+    return 0;
+}
+
+// The progress of `fix <id> insert/*` (the same on every rank): state[0] the step of its next
+// insertion (0: none), [1] the particles inserted so far, [2] their mass [kg], [3] the step of its
+// first insertion, [4] that of its most recent (-1: none yet). Read into state (set == 0) or set
+// from it (set != 0). Returns 0, or -1 when there is no such fix.
+int collheat_insert_progress(void *ptr, const char *id, double *state, int set)
+{
+    LAMMPS *lmp = static_cast<LAMMPS *>(ptr);
+    Fix *fix = fix_of_style(lmp, id, "insert/");
+    if (fix == NULL) return -1;
+    FixInsert *ins = static_cast<FixInsert *>(fix);
+    if (set) {
+        ins->next_reneighbor = static_cast<bigint>(state[0]);
+        ins->ninserted = static_cast<int>(state[1]);
+        ins->massinserted = state[2];
+        ins->first_ins_step = static_cast<int>(state[3]);
+        ins->most_recent_ins_step = static_cast<int>(state[4]);
+    } else {
+        state[0] = static_cast<double>(ins->next_reneighbor);
+        state[1] = ins->ninserted;
+        state[2] = ins->massinserted;
+        state[3] = ins->first_ins_step;
+        state[4] = ins->most_recent_ins_step;
+    }
     return 0;
 }
 

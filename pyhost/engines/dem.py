@@ -443,6 +443,25 @@ class Dem:
         self._order("set_random_states", states)
         set_random_states(self.lmp, states, 0, 1 if self.link is None else self.link.size)
 
+    def insertion_progress(self) -> dict:
+        """The progress of each insertion fix of the script (``Liggghts.insert_progress``), by fix
+        id: the same on every rank, read on rank 0."""
+        found = {fix: self.lmp.insert_progress(fix) for fix in self._insertions()}
+        return {fix: p for fix, p in found.items() if p is not None}
+
+    @collective
+    def set_insertion_progress(self, progress: dict) -> None:
+        """Put that progress back (a restart), on every rank: an insertion that was done stays
+        done, on any number of ranks."""
+        if not progress:
+            return
+        self._order("insertion_progress", progress)
+        for fix, p in progress.items():
+            self.lmp.insert_progress(fix, [float(x) for x in p])
+
+    def _insertions(self) -> list[str]:
+        return [key.split(" ", 1)[1] for key in self.info.randoms if key.startswith("insert ")]
+
     def engine_command(self, line: str) -> None:
         """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""
         self._raw(line)

@@ -150,6 +150,12 @@ class DemEngine(Protocol):
     def set_random_states(self, states: dict) -> None:
         """Set the insertion generators' states."""
 
+    def insertion_progress(self) -> dict:
+        """Each insertion's progress (next insertion step, particles and mass inserted so far)."""
+
+    def set_insertion_progress(self, progress: dict) -> None:
+        """Set each insertion's progress."""
+
 
 MEMBERS = tuple(sorted({n for n in vars(DemEngine) if not n.startswith("_")} | set(DemEngine.__annotations__)))
 """Every name of the interface."""

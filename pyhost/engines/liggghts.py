@@ -71,6 +71,7 @@ _HELPER_DECLARATIONS = {
     "collheat_fix_external_force": (_c.POINTER(_c.c_double), [_vp, _cp]),
     "collheat_move_mesh_time": (_int, [_vp, _cp, _c.POINTER(_c.c_double), _int]),
     "collheat_random_state": (_int, [_vp, _cp, _cp, _c.POINTER(_int), _int]),
+    "collheat_insert_progress": (_int, [_vp, _cp, _c.POINTER(_c.c_double), _int]),
     "collheat_keep_mesh_bins": (_int, [_vp]),
     "collheat_dump_every": (_int, [_vp]),
     "collheat_unit_style": (_cp, [_vp]),
@@ -484,7 +485,11 @@ class Liggghts:
 
     def atom(self, name: str) -> np.ndarray:
         """Zero-copy view of a per-atom array of the local atoms, in LIGGGHTS' local order:
-        x, v, f, omega (n, 3); radius, rmass, id, type (n,). Valid until the next run."""
+        x, v, f, omega (n, 3); radius, rmass, id, type (n,); ``release_step`` (n,): the step at
+        which fix insert/stream releases each atom it inserted (0: none; the fixes keep it in
+        the per-atom array of their ``fix release_fix_insert_stream``). Valid until the next run."""
+        if name == "release_step":
+            return self._release_step()
         if name not in _ATOM:
             raise ValueError(f"unknown per-atom array '{name}'; choices: {', '.join(_ATOM)}")
         ctype, cols = _ATOM[name]
@@ -496,6 +501,18 @@ class Liggghts:
             first = ctypes.cast(raw, ctypes.POINTER(ctypes.POINTER(ctype)))[0]
             return np.ctypeslib.as_array(first, shape=(n, cols))
         return np.ctypeslib.as_array(ctypes.cast(raw, ctypes.POINTER(ctype)), shape=(n,))
+
+    def _release_step(self) -> np.ndarray:
+        # column 4 of fix insert/stream's 14 values per atom (its finalize_insertion in
+        # fix_insert_stream.cpp), rows contiguous (LAMMPS' memory->grow of a 2-d array)
+        raw = self.lib.lammps_extract_fix(self.ptr, b"release_fix_insert_stream", 1, 2, 0, 0)
+        if not raw:
+            raise LiggghtsError("no fix insert/stream (its per-atom 'release_fix_insert_stream')")
+        n = self.nlocal
+        if n == 0:
+            return np.zeros(0)
+        first = ctypes.cast(raw, ctypes.POINTER(ctypes.POINTER(ctypes.c_double)))[0]
+        return np.ctypeslib.as_array(first, shape=(n, 14))[:, 4]
 
     def property_atom(self, name: str) -> np.ndarray:
         """Zero-copy view of the per-atom scalar of a ``fix property/atom`` named ``name``
@@ -541,6 +558,16 @@ class Liggghts:
                                              int(value is not None)):
             return None
         return s.value
+
+    def insert_progress(self, id_: str, value: list | None = None) -> list | None:
+        """The progress of ``fix <id_> insert/*`` (None: there is none): [the step of its next
+        insertion (0: none more), particles inserted so far, their mass in kg, the step of its first
+        insertion, that of its most recent (-1: none)]; with ``value``, set it first. LIGGGHTS'
+        restart loses a finished insertion's 'none more' (see plugins/liggghts/restart_state.cpp)."""
+        state = (ctypes.c_double * 5)(*(value or [0.0] * 5))
+        if self.helper.collheat_insert_progress(self.ptr, id_.encode(), state, int(value is not None)):
+            return None
+        return list(state)
 
     # -- contacts ---------------------------------------------------------------------
     def add_pair_contacts(self, compute_id: str = "pairs") -> None:

@@ -251,6 +251,10 @@ class Follower:
     def do_set_random_states(self, states) -> None:
         set_random_states(self.lmp, states, self.comm.Get_rank(), self.comm.Get_size())
 
+    def do_insertion_progress(self, progress) -> None:
+        for fix, p in progress.items():
+            self.lmp.insert_progress(fix, [float(x) for x in p])
+
     def do_put(self, ids, arrays) -> None:
         put_by_id(self.lmp, ids, arrays)
 

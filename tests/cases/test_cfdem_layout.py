@@ -192,6 +192,28 @@ def test_cfdem_layout_stopped_and_restarted_is_the_run_never_stopped(tmp_path):
     assert np.array_equal(velocities(cfd), after)
 
 
+
+def test_restart_after_the_fluid_cases_viscosity_changed_is_refused(tmp_path):
+    """The user's OpenFOAM case is fingerprinted when the run starts, as the script is: its gas
+    viscosity changed after a stop (constant/transportProperties, nu 1e-5 to 2e-5 m^2/s) is
+    refused at --restart (exit 2) naming the file, before any engine starts: the checkpoint
+    and the output as they were. (It used to be continued silently, with the old viscosity in
+    the saved fields' case and the new one in the copy.)"""
+    from conftest import STOPPER
+    cfd = cfdem_case(tmp_path)
+    stopped = subprocess.run([sys.executable, "-c", STOPPER, "303", "SIGTERM", "run", str(cfd)], capture_output=True,
+                             text=True, cwd=ROOT, timeout=600)
+    assert stopped.returncode == 143, stopped.stdout[-3000:] + stopped.stderr[-3000:]
+    props = cfd / "constant" / "transportProperties"
+    manifest = json.loads((cfd / "output" / "checkpoint" / "manifest.json").read_text())
+    assert str(props) in manifest["inputs"] and str(cfd / "system" / "controlDict") in manifest["inputs"]
+    FoamFile(props)["nu"] = FoamFile.Dimensioned(name="nu", value=2 * NU, dimensions=[0, 2, -1, 0, 0, 0, 0])
+    before = {p: p.read_bytes() for p in sorted((cfd / "output").rglob("*")) if p.is_file()}
+    r = run(cfd, "--restart")
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert f"{props} is not the file the checkpoint's run read (changed since it started" in r.stderr
+    assert {p: p.read_bytes() for p in sorted((cfd / "output").rglob("*")) if p.is_file()} == before
+
 def cfdem_run1_case(root: Path, test_end: float) -> Path:
     """The layout with CFDEM's own coupling fixes and the script ending in ``run 1`` (as
     ErgunTestMPI_restart's and ErgunTestMPI_cgs's), the solver writing every 0.01 s of its own

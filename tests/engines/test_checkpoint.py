@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import STOPPER
+from conftest import INSERTIONS, STOPPER, pour
 
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
@@ -218,6 +218,10 @@ def damage_manifest(ck, key, value):
     (lambda case, ck: (ck / "host.json").write_text("{"), "host.json is not the file written"),
     (lambda case, ck: os.truncate(ck.parent / "collisions.csv", 50), "collisions.csv: 50 bytes, where the checkpoint"),
     (lambda case, ck: edit_first_byte(ck.parent / "history.csv"), "history.csv: its bytes before the checkpoint"),
+    # the VTK folder deleted: a restart used to write a .pvd listing the frames no longer there
+    (lambda case, ck: shutil.rmtree(ck.parent / "vtk"), "vtk/particles_00000.vtu is missing (11 of the 11 frames of "
+                                                         "particles.pvd written before the checkpoint are)"),
+    (lambda case, ck: (ck.parent / "vtk" / "particles_00007.vtu").unlink(), "particles_00007.vtu is missing (1 of"),
 ])
 def test_bad_checkpoint_is_refused_and_left_as_it_was(stopped, capsys, damage, message):
     case_dir, out = stopped
@@ -372,10 +376,123 @@ def test_restart_of_an_edited_script_is_refused(tmp_path, capsys):
     script.write_text(script.read_text().replace("vel constant 0. 0. -0.3 set_property Temp 400.",
                                                  "vel constant 0. 0. -0.5 set_property Temp 400."))
     before = fingerprint(out / "checkpoint")
-    assert "in.liggghts is not the script the checkpoint's run read" in refused(
+    assert "in.liggghts is not the file the checkpoint's run read (changed since it started" in refused(
         capsys, "run", folder, "--test", "--out", out, "--restart")
     assert fingerprint(out / "checkpoint") == before
 
+
+# two beads resting on the floor, read by 'read_data beads.data' in place of create_box
+BEADS = """LIGGGHTS data file: two beads of 2 mm
+
+2 atoms
+1 atom types
+
+-0.01 0.01 xlo xhi
+-0.01 0.01 ylo yhi
+0 0.03 zlo zhi
+
+Atoms
+
+1 1 0.002 2500 0 0 0.001
+2 1 0.002 2500 0.004 0 0.001
+"""
+
+
+def moved_down_4_mm(path: Path) -> None:
+    path.write_text(path.read_text().replace(" 0.012\n", " 0.008\n"))
+
+
+@pytest.mark.parametrize("insertion, edit, name", [
+    ("stream", moved_down_4_mm, "face.stl"),
+    ("pack_once", lambda p: p.write_text(p.read_text().replace("0.004 0 0.001", "0.005 0 0.001")), "beads.data"),
+])
+def test_restart_after_an_input_file_changed_is_refused(tmp_path, capsys, insertion, edit, name):
+    """Every file the run read is fingerprinted (SHA-256) when it starts: an STL mesh of the
+    script's (insert/stream's face moved 4 mm down) or its read_data file (a bead moved 1 mm)
+    edited after the stop is refused at --restart (exit 2) naming the file, before any engine
+    starts, the checkpoint left as it was. (They used to be continued silently.)"""
+    folder = pour(tmp_path, insertion)
+    script = folder / "in.pour"
+    script.write_text(script.read_text().replace("create_box 1 box", "read_data beads.data"))
+    (folder / "beads.data").write_text(BEADS)
+    out = tmp_path / "out"
+    r = pyhost("run", folder, "--out", out, stop=(1403, "SIGTERM"))
+    assert r.returncode == 143, r.stderr[-2000:]
+    manifest = json.loads((out / "checkpoint" / "manifest.json").read_text())
+    read = {"in.pour", "beads.data"} | ({"face.stl"} if insertion == "stream" else set())
+    assert {Path(f).name for f in manifest["inputs"]} == read
+    edit(folder / name)
+    before = fingerprint(out / "checkpoint")
+    message = refused(capsys, "run", folder, "--out", out, "--restart")
+    assert f"{folder / name} is not the file the checkpoint's run read (changed since it started" in message
+    assert fingerprint(out / "checkpoint") == before
+
+
+@pytest.mark.parametrize("insertion", sorted(INSERTIONS))
+def test_script_insertion_restarts_where_it_was(tmp_path, insertion):
+    """Each insertion fix's progress goes through a restart: stopped by SIGTERM at step 1403 (a
+    checkpoint at 1500, the periodic one) and restarted, the pour equals the run never stopped
+    bit for bit (collisions.csv, history.csv, summary: particles inserted, collisions, heat from
+    the 400 K floor, balance). LIGGGHTS' own restart schedules an insertion that was done again
+    at the step after the restart: 'insert/pack ... insert_every once' inserted 68 particles
+    instead of 50 (290 collisions instead of 258), and a rate or stream insertion done before
+    the checkpoint stopped the restarted run at its final checkpoint (LIGGGHTS: "'start' step
+    can not be before current step")."""
+    folder = pour(tmp_path, insertion)
+    whole, out = tmp_path / "whole", tmp_path / "out"
+    r = pyhost("run", folder, "--test", "--out", whole)
+    assert r.returncode == 0, r.stderr[-2000:]
+    stopped, _ = sigterm_and_restart(folder, out, 1403)
+    assert "checkpoint at t = 0.015 s (step 1500)" in stopped
+    a, b = summary(out), summary(whole)
+    print(f"{insertion}: inserted {a['inserted']} (whole run {b['inserted']}), collisions {a['collisions']} "
+          f"({b['collisions']}), heat from the floor {a['heat_from_walls']:.6g} J ({b['heat_from_walls']:.6g})")
+    assert a["status"] == "completed" and a["inserted"] == b["inserted"] > 0
+    assert a["collisions"] == b["collisions"] > 0
+    assert a["heat_from_walls"] == b["heat_from_walls"] > 0
+    assert abs(a["energy_balance_error"]) < 1e-12
+    assert a == b
+    for name in ("collisions.csv", "history.csv"):
+        assert (out / name).read_bytes() == (whole / name).read_bytes(), name
+
+
+
+@pytest.mark.parametrize("stop, said", [(1403, "checkpoint at t = 0.015 s (step 1500)"),
+                                        (4503, "checkpoint at t = 0.046 s (step 4600)")])
+def test_a_box_that_empties_checkpoints_and_restarts(tmp_path, stop, said):
+    """The pour with no floor ('thermo_modify lost ignore': the beads leave through the bottom
+    face, which is fixed) and a checkpoint every 500 steps: every bead leaves by 0.06 s. A
+    checkpoint at a step where beads were past the face used to fail (LIGGGHTS' write_restart
+    kept them, the set-up after it dropped them: "corrupt checkpoint", exit 2, at t = 0.015 s
+    with 16 of 50 beads gone, .checkpoint.new left). Now the run completes, with a checkpoint of
+    the empty box at its end and no .checkpoint.new, and a SIGTERM at step 1403, while beads
+    leave, or at 4503, the box empty, restarts to the same collisions, heat and departures bit
+    for bit."""
+    folder = pour(tmp_path, "pack_once")
+    script = folder / "in.pour"
+    text = script.read_text().replace("vel constant 0 0 -0.5", "vel uniform 0 0 -0.5 0.3 0.3 0.3")
+    floor = next(line for line in text.splitlines() if line.startswith("fix floor"))
+    script.write_text(text.replace(floor, "thermo_modify lost ignore").replace("run 3000", "run 6000"))
+    toml = folder / "case.toml"
+    toml.write_text(toml.read_text().replace('fix = "floor"', 'fix = "sides"').replace("checkpoint = 0.015",
+                                                                                     "checkpoint = 0.005"))
+    whole, out = tmp_path / "whole", tmp_path / "out"
+    r = pyhost("run", folder, "--test", "--out", whole)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "checkpoint at t = 0.06 s (step 6000)" in r.stdout and not (whole / ".checkpoint.new").exists()
+    b = summary(whole)
+    assert b["status"] == "completed" and b["departed"] == b["inserted"] == 50
+    stopped, _ = sigterm_and_restart(folder, out, stop)
+    assert said in stopped
+    if stop == 4503:                # (the beads left by then)
+        assert json.loads((out / "checkpoint" / "host.json").read_text())["totals"]["departed"] == 50
+    a = summary(out)
+    print(f"departed {a['departed']} of {a['inserted']}, collisions {a['collisions']} ({b['collisions']}), "
+          f"heat from the 400 K side wall {a['heat_from_walls']:.6g} J ({b['heat_from_walls']:.6g})")
+    assert a["collisions"] == b["collisions"] > 0 and a["heat_from_walls"] == b["heat_from_walls"] > 0
+    assert abs(a["energy_balance_error"]) < 1e-12 and a == b
+    for name in ("collisions.csv", "history.csv"):
+        assert (out / name).read_bytes() == (whole / name).read_bytes(), name
 
 # -- fluid scenes: the solver's fields at the checkpoint (17 digits), its restart from them ----------
 

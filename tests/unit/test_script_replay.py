@@ -98,3 +98,24 @@ def test_a_script_without_a_box_before_the_run_is_refused(tmp_path):
     commands = read_script(tmp_path / "in.nobox")
     with pytest.raises(ScriptError, match="defines no box"):
         replay(commands, 1, Path("x"))
+
+
+def test_the_files_a_script_reads_are_its_inputs_and_not_those_it_writes(tmp_path):
+    """What a restart fingerprints besides the script (pyhost.script.input_files): the STL of a
+    mesh (its 'file' keyword is read, a fix print's is written), a read_data file; not a dump,
+    nor a restart file the script writes and reads back, nor a word that only looks like a file."""
+    from pyhost.script import input_files
+
+    (tmp_path / "meshes").mkdir()
+    for name in ("meshes/wall.stl", "beads.data", "bed.restart", "out.dump", "printed.txt"):
+        (tmp_path / name).write_text("x")
+    (tmp_path / "in.run").write_text("""read_data beads.data
+fix wall all mesh/surface file meshes/wall.stl type 1
+fix told all print 100 "told" file printed.txt screen no
+dump d all custom 100 out.dump id x y z
+write_restart bed.restart
+read_restart bed.restart
+variable f string ${name}.stl
+""")
+    found = input_files(read_script(tmp_path / "in.run"), tmp_path)
+    assert found == [tmp_path / "beads.data", tmp_path / "meshes" / "wall.stl"]
