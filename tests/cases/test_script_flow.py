@@ -89,3 +89,18 @@ def test_a_restart_inside_a_loop_goes_on_where_the_loop_stood(tmp_path):
     for name in ("collisions.csv", "history.csv"):
         assert (cut / name).read_bytes() == (tmp_path / "out" / name).read_bytes(), name
     assert json.loads((cut / "summary.json").read_text()) == whole
+
+
+@pytest.mark.parametrize("flow", ["loop", "if_runs"])
+def test_control_flow_on_two_ranks_is_the_serial_run(tmp_path, flow):
+    """Under mpirun -np 2 every rank follows rank 0's input loop (the if's branch is LIGGGHTS'
+    on all ranks, the next's on each): the same steps and collisions.csv byte for byte."""
+    logs = {}
+    for ranks in (1, 2):
+        folder = tmp_path / str(ranks)
+        folder.mkdir()
+        r, s = run(folder, BOX + FLOWS[flow][0], toml(), ranks=ranks)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        assert s["steps"] == FLOWS[flow][1] and abs(s["energy_balance_error"]) < 1e-12
+        logs[ranks] = (folder / "out" / "collisions.csv").read_bytes()
+    assert logs[1] == logs[2]
