@@ -274,7 +274,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         script, particles = box_world(scene, out, start, resume and resume["restart"])
         variables = {}
     particles["resume"] = resume
-    commands = read_script(script, scene.folder)
+    commands = read_script(script, scene.folder, effects["particle_temperatures"])
     if scene.scripted:
         check_types(commands, scene.materials, str(scene.path))
     fluid = start_fluid(scene, out / "fluid", resume and resume["fluid"]) if effects["fluid_solver"] else None
