@@ -464,7 +464,12 @@ class Dem:
         """The primitive and mesh walls, for the event recorder, with their contact codes; of
         the ``heated`` ones ((fix, mesh) whose collisions the host gives heat), those through
         which the script's fix heat/gran conducts (a temperature in the script) keep its flux
-        through each new contact (``wall_conduction``). Returns their codes."""
+        through each new contact (``wall_conduction``). Returns their codes. The recorder's
+        fix comes after every wall's (``ContactEvents.keep_last``)."""
+        if self.events.keep_last():
+            self._pending = None
+            self.log("the host's contact recorder (fix collheat_events) given anew after the script's walls "
+                     "defined since the first run: it sums heat/gran's flux through their contacts after they add it")
         primitive = [(fix, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items() if w.primitive is not None]
         if not self.events.primitives(*(zip(*primitive) if primitive else ([], []))):
             raise ScriptError(f"the primitive walls {', '.join(f for f, _ in primitive)}: one is not a fix wall/gran "

@@ -170,3 +170,99 @@ def test_a_sphere_resting_on_a_hot_floor_warms_by_enduring_conduction(tmp_path):
     assert T[b] - T[a] == pytest.approx(expected - T[a], rel=1e-3)
     assert summary["heat_gran_walls_undone"] > 0.0 and summary["particle_wall"] >= 1
     assert abs(summary["energy_balance_error"]) < 1e-12
+
+
+CURVED = """{head}fix gravi all gravity 9.81 vector {g}
+{wall}create_atoms 1 single {at} units box
+set group all diameter 0.002 density 2500
+fix heattransfer all heat/gran initial_temperature 300.
+fix integr all nve/sphere
+{dump}run 10
+{late}run 5190
+"""
+HEAD = SCRIPT.split("fix gravi")[0]
+HOT = "fix tube all wall/gran model hertz tangential history primitive type 1 {} temperature 350.\n"
+WALLS = {   # the wall, the pull towards it, where the sphere starts: 0.1 mm from it, moving at 0 m/s
+    "zcylinder": ("zcylinder 0.009 0.01 0.01", "1 0 0", "0.0179 0.01 0.01"),
+    "xcylinder": ("xcylinder 0.009 0.01 0.01", "0 1 0", "0.01 0.0179 0.01"),     # (R, y, z of the axis)
+    "ycylinder": ("ycylinder 0.009 0.01 0.01", "0 0 -1", "0.01 0.01 0.0021"),    # (R, z, x of the axis)
+    "zplane": ("zplane 0.0", "0 0 -1", "0.01 0.01 0.0011"),
+}
+
+
+def run_curved(tmp_path, wall, late, entry):
+    """The sphere against ``wall`` in plain LIGGGHTS and in the host (with or without a
+    [[walls]] entry at the wall's 350 K): (plain LIGGGHTS' Temp [K] and heat/gran's heatFlux
+    into the sphere [W] at the end of every step, from 0, the host's summary, its collision
+    rows, its output)."""
+    primitive, g, at = WALLS[wall]
+    fill = dict(head=HEAD, g=g, at=at, wall="" if late else HOT.format(primitive), late=HOT.format(primitive) if late else "")
+    native = tmp_path / "native"
+    native.mkdir()
+    (native / "in.drop").write_text(CURVED.format(**fill, dump="dump t all custom 1 temp.dump id f_Temp[0] f_heatFlux[0]\n"
+                                                               'dump_modify t format "%d %.17g %.17g"\n'))
+    r = subprocess.run(["liggghts", "-in", "in.drop", "-screen", "/dev/null", "-log", "none"], cwd=native,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout[-2000:]
+    lines = (native / "temp.dump").read_text().splitlines()
+    T, q = np.array([[float(x) for x in lines[k + 9].split()[1:]] for k in range(0, len(lines), 10)]).T
+    case = tmp_path / "host"
+    case.mkdir()
+    (case / "in.drop").write_text(CURVED.format(**fill, dump=""))
+    scene = SCENE.replace('fix = "floor"', 'fix = "tube"')
+    (case / "case.toml").write_text(scene if entry else scene.split("[materials.steel]")[0] + "[output]" + scene.split("[output]")[1])
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--out", str(case / "out")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    with open(case / "out" / "collisions.csv") as f:
+        rows = list(csv.DictReader(f))
+    return T, q, json.loads((case / "out" / "summary.json").read_text()), rows, r.stdout
+
+
+M_C = 2500.0 * 4.0 / 3.0 * np.pi * 0.001**3 * 840.0      # the sphere's m c [J/K]
+DT = 1e-6
+
+
+@pytest.mark.parametrize("wall, late", [("zcylinder", False), ("zcylinder", True), ("zplane", True)])
+def test_heat_gran_through_a_cylinder_or_a_wall_defined_late_is_counted_as_liggghts_conducts_it(wall, late, tmp_path):
+    """A sphere pulled against a hot wall (350 K) from 0.1 mm, 5,200 steps of 1 us: it touches
+    it once (v0 = 0.044 m/s) and bounces off; the wall a zcylinder, or a wall defined after the
+    script's first run (after the host's contact recorder: its heat/gran flux was added after
+    the recorder summed the step's, and the run ended in exit 3, energy balance broken by the
+    sphere's whole gain, 1.03e-5 J). No [[walls]] entry: the host changes no temperature, so its
+    heat_from_script_walls is plain LIGGGHTS' sum of heatFlux dt over the steps, to 1e-12, and
+    its m c (T_end - T_0) to 1e-10 (the dumped Temp near 300 K carries its 3.9 mK rise to about
+    1e-11), and the sphere ends at plain LIGGGHTS' Temp."""
+    T, q, summary, rows, out = run_curved(tmp_path, wall, late, entry=False)
+    conducted = DT * float(np.sum(q))
+    print(f"{wall}{' after the first run' if late else ''}: {len(rows)} wall collisions; plain LIGGGHTS: sum "
+          f"heatFlux dt {conducted:.15e} J, m c dT {M_C * (T[-1] - T[0]):.15e} J; host heat_from_script_walls "
+          f"{summary['heat_from_script_walls']:.15e} J, balance {summary['energy_balance_error']:.2e}")
+    assert len(rows) == 1 and conducted > 1e-6
+    assert summary["heat_from_script_walls"] == pytest.approx(conducted, rel=1e-12, abs=0.0)
+    assert summary["heat_from_script_walls"] == pytest.approx(M_C * (T[-1] - T[0]), rel=1e-10, abs=0.0)
+    assert summary["sum_mcT_end"] == pytest.approx(M_C * T[-1], rel=1e-15, abs=0.0)
+    assert abs(summary["energy_balance_error"]) < 1e-12
+    assert ("given anew after the script's walls" in out) == late
+
+
+@pytest.mark.parametrize("wall", ["zcylinder", "xcylinder", "ycylinder"])
+def test_heat_grans_share_during_a_cylinder_collision_is_what_liggghts_conducted(wall, tmp_path):
+    """The same against each kind of cylinder, with a [[walls]] entry at 350 K: the models move
+    the collision's heat, and heat/gran's share during its t_coll, taken back by the host, is
+    plain LIGGGHTS' heatFlux dt over the contact's first t_coll / dt steps (the last in part;
+    fix wall/gran's addHeatFlux: a cylinder's contact area is the sphere's cap,
+    pi (R^2 - (R - delta)^2), as a plane's), to 1e-12; the balance closes to 1e-12."""
+    _, q, summary, rows, _ = run_curved(tmp_path, wall, False, entry=True)
+    first = int(np.flatnonzero(q)[0])
+    t_coll = float(rows[0]["t_coll"])
+    share = np.clip(t_coll / DT - np.arange(len(q) - first), 0.0, 1.0)
+    expected = DT * float(np.sum(q[first:] * share))
+    print(f"{wall}: {len(rows)} wall collisions, at step {first}, v0 {float(rows[0]['v0']):.4f} m/s, "
+          f"t_coll {t_coll:.3e} s; heat/gran in t_coll: LIGGGHTS {expected:.15e} J; taken back "
+          f"{summary['heat_gran_walls_undone']:.15e} J; balance {summary['energy_balance_error']:.2e}")
+    assert len(rows) == 1 and abs(float(rows[0]["time"]) - first * DT) < 0.5 * DT
+    assert 5.0 < t_coll / DT < 50.0 and expected > 0.0
+    assert summary["heat_gran_walls_undone"] == pytest.approx(expected, rel=1e-12, abs=0.0)
+    assert summary["heat_from_walls"] > 0.0
+    assert abs(summary["energy_balance_error"]) < 1e-12
