@@ -140,6 +140,23 @@ def read_script(path: str | Path, folder: str | Path | None = None, temperatures
     return commands
 
 
+def host_fix_refusal(line: str) -> str | None:
+    """Why a LIGGGHTS command would remove or replace a fix, compute or variable of the host's
+    (its id begins with HOST_PREFIX, or it unfixes Temp), or None."""
+    w = line.split()
+    if len(w) < 2 or w[0] not in HOST_ID_COMMANDS:
+        return None
+    if w[1].startswith(HOST_PREFIX):
+        return (f"'{line}': ids beginning with '{HOST_PREFIX}' are the host's own (its contact recorder fix "
+                "collheat_events, its fluid force fix collheat_fluid, the variables it evaluates): the script may "
+                "not define, remove or change one (without the recorder no collision is seen); give the script's "
+                "own another id")
+    if w[:2] == ["unfix", "Temp"]:
+        return ("'unfix Temp': the particles' temperatures live in the Temp property (the host's collision heat "
+                "and energy balance read and write it): the script may not remove it")
+    return None
+
+
 def _check_host_ids(commands: list[Command], temperatures: bool) -> None:
     """A script's command that would remove or replace what the host adds (Dem.prepare, at
     the first run) is refused with its file and line: without the contact recorder no
@@ -161,18 +178,10 @@ def _check_host_ids(commands: list[Command], temperatures: bool) -> None:
                 continue                # unbalanced quotes: LIGGGHTS says so itself
         for line in lines:
             w = line.split()
-            if len(w) < 2 or w[0] not in HOST_ID_COMMANDS:
-                continue
-            if w[1].startswith(HOST_PREFIX):
-                raise ScriptError(f"{cmd.where()}: '{line}': ids beginning with '{HOST_PREFIX}' are the host's own (its "
-                                  "contact recorder fix collheat_events, its fluid force fix collheat_fluid, the "
-                                  "variables it evaluates): the script may not define, remove or change one (without "
-                                  "the recorder no collision is seen); give the script's own another id")
-            if w[:2] == ["unfix", "Temp"]:
-                raise ScriptError(f"{cmd.where()}: 'unfix Temp': the particles' temperatures live in the Temp "
-                                  "property (the host's collision heat and energy balance read and write it): "
-                                  "the script may not remove it")
-            if w[0] == "fix" and w[1] == "Temp" and k > first_run and temperatures and not own_temp:
+            why = host_fix_refusal(line)
+            if why:
+                raise ScriptError(f"{cmd.where()}: {why}")
+            if w[:2] == ["fix", "Temp"] and k > first_run and temperatures and not own_temp:
                 raise ScriptError(f"{cmd.where()}: '{line}': the host adds 'fix Temp all property/atom Temp' at "
                                   f"the script's first run ({commands[first_run].where()}), where the script has "
                                   "none: this would replace it and the temperatures it holds; define the script's "

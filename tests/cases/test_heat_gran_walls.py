@@ -178,11 +178,11 @@ def test_a_sphere_resting_on_a_hot_floor_warms_by_enduring_conduction(tmp_path):
 CURVED = """{head}fix gravi all gravity 9.81 vector {g}
 {wall}create_atoms 1 single {at} units box
 set group all diameter 0.002 density 2500
-fix heattransfer all heat/gran initial_temperature 300.
-fix integr all nve/sphere
-{dump}run 10
-{late}run 5190
+{heat}fix integr all nve/sphere
+run 10
+{late}{dump}run 5190
 """
+HEAT = "fix heattransfer all heat/gran initial_temperature 300.\n"
 HEAD = SCRIPT.split("fix gravi")[0]
 HOT = "fix tube all wall/gran model hertz tangential history primitive type 1 {} temperature 350.\n"
 WALLS = {   # the wall, the pull towards it, where the sphere starts: 0.1 mm from it, moving at 0 m/s
@@ -194,12 +194,14 @@ WALLS = {   # the wall, the pull towards it, where the sphere starts: 0.1 mm fro
 
 
 def run_curved(tmp_path, wall, late, entry):
-    """The sphere against ``wall`` in plain LIGGGHTS and in the host (with or without a
+    """The sphere against ``wall`` (defined after the first run with ``late``, its fix heat/gran
+    too with late = "both") in plain LIGGGHTS and in the host (with or without a
     [[walls]] entry at the wall's 350 K): (plain LIGGGHTS' Temp [K] and heat/gran's heatFlux
     into the sphere [W] at the end of every step, from 0, the host's summary, its collision
     rows, its output)."""
     primitive, g, at = WALLS[wall]
-    fill = dict(head=HEAD, g=g, at=at, wall="" if late else HOT.format(primitive), late=HOT.format(primitive) if late else "")
+    fill = dict(head=HEAD, g=g, at=at, wall="" if late else HOT.format(primitive), heat="" if late == "both" else HEAT,
+                late=(HEAT if late == "both" else "") + (HOT.format(primitive) if late else ""))
     native = tmp_path / "native"
     native.mkdir()
     (native / "in.drop").write_text(CURVED.format(**fill, dump="dump t all custom 1 temp.dump id f_Temp[0] f_heatFlux[0]\n"
@@ -208,11 +210,14 @@ def run_curved(tmp_path, wall, late, entry):
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout[-2000:]
     lines = (native / "temp.dump").read_text().splitlines()
+    assert lines[1] == "10"               # the dumps from step 10 on, before any contact
     T, q = np.array([[float(x) for x in lines[k + 9].split()[1:]] for k in range(0, len(lines), 10)]).T
     case = tmp_path / "host"
     case.mkdir()
     (case / "in.drop").write_text(CURVED.format(**fill, dump=""))
     scene = SCENE.replace('fix = "floor"', 'fix = "tube"')
+    if late == "both":                    # the Temp the host adds at the first run: heat/gran's 300 K
+        scene = scene.replace('temperature = 0.0\n', 'temperature = 300.0\n', 1)
     (case / "case.toml").write_text(scene if entry else scene.split("[materials.steel]")[0] + "[output]" + scene.split("[output]")[1])
     r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--out", str(case / "out")],
                        capture_output=True, text=True, cwd=ROOT, timeout=600)
@@ -226,19 +231,21 @@ M_C = 2500.0 * 4.0 / 3.0 * np.pi * 0.001**3 * 840.0      # the sphere's m c [J/K
 DT = 1e-6
 
 
-@pytest.mark.parametrize("wall, late", [("zcylinder", False), ("zcylinder", True), ("zplane", True)])
+@pytest.mark.parametrize("wall, late", [("zcylinder", False), ("zcylinder", True), ("zplane", True),
+                                        ("zcylinder", "both")])
 def test_heat_gran_through_a_cylinder_or_a_wall_defined_late_is_counted_as_liggghts_conducts_it(wall, late, tmp_path):
-    """A sphere pulled against a hot wall (350 K) from 0.1 mm, 5,200 steps of 1 us: it touches
+    """A sphere pulled against a hot wall (350 K) from 0.1 mm, 10 + 5,190 steps of 1 us: it touches
     it once (v0 = 0.044 m/s) and bounces off; the wall a zcylinder, or a wall defined after the
     script's first run (after the host's contact recorder: its heat/gran flux was added after
     the recorder summed the step's, and the run ended in exit 3, energy balance broken by the
-    sphere's whole gain, 1.03e-5 J). No [[walls]] entry: the host changes no temperature, so its
+    sphere's whole gain, 1.03e-5 J), or the wall and the fix heat/gran defined after it (the
+    recorder did not follow a heat/gran that came after the first run: the same). No [[walls]] entry: the host changes no temperature, so its
     heat_from_script_walls is plain LIGGGHTS' sum of heatFlux dt over the steps, to 1e-12, and
     its m c (T_end - T_0) to 1e-10 (the dumped Temp near 300 K carries its 3.9 mK rise to about
     1e-11), and the sphere ends at plain LIGGGHTS' Temp."""
     T, q, summary, rows, out = run_curved(tmp_path, wall, late, entry=False)
     conducted = DT * float(np.sum(q))
-    print(f"{wall}{' after the first run' if late else ''}: {len(rows)} wall collisions; plain LIGGGHTS: sum "
+    print(f"{wall}{' after the first run' if late else ''}{', heat/gran too' if late == 'both' else ''}: {len(rows)} wall collisions; plain LIGGGHTS: sum "
           f"heatFlux dt {conducted:.15e} J, m c dT {M_C * (T[-1] - T[0]):.15e} J; host heat_from_script_walls "
           f"{summary['heat_from_script_walls']:.15e} J, balance {summary['energy_balance_error']:.2e}")
     assert len(rows) == 1 and conducted > 1e-6
@@ -246,7 +253,7 @@ def test_heat_gran_through_a_cylinder_or_a_wall_defined_late_is_counted_as_liggg
     assert summary["heat_from_script_walls"] == pytest.approx(M_C * (T[-1] - T[0]), rel=1e-10, abs=0.0)
     assert summary["sum_mcT_end"] == pytest.approx(M_C * T[-1], rel=1e-15, abs=0.0)
     assert abs(summary["energy_balance_error"]) < 1e-12
-    assert ("given anew after the script's walls" in out) == late
+    assert ("given anew after the script's walls" in out) == bool(late)
 
 
 @pytest.mark.parametrize("wall", ["zcylinder", "xcylinder", "ycylinder"])
@@ -261,6 +268,7 @@ def test_heat_grans_share_during_a_cylinder_collision_is_what_liggghts_conducted
     t_coll = float(rows[0]["t_coll"])
     share = np.clip(t_coll / DT - np.arange(len(q) - first), 0.0, 1.0)
     expected = DT * float(np.sum(q[first:] * share))
+    first += 10                                                     # the step (the dumps' first is 10)
     print(f"{wall}: {len(rows)} wall collisions, at step {first}, v0 {float(rows[0]['v0']):.4f} m/s, "
           f"t_coll {t_coll:.3e} s; heat/gran in t_coll: LIGGGHTS {expected:.15e} J; taken back "
           f"{summary['heat_gran_walls_undone']:.15e} J; balance {summary['energy_balance_error']:.2e}")
