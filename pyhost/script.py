@@ -170,13 +170,7 @@ def _check_host_ids(commands: list[Command], temperatures: bool) -> None:
                                         or c.text.split()[3:5] == ["property/atom", "Temp"])
                    for c in commands[:first_run])      # (as Dem.prepare decides)
     for k, cmd in enumerate(commands):
-        lines = [cmd.text]
-        if cmd.name == "if":
-            try:
-                lines = [w for w in cmd.words[2:] if w not in ("then", "elif", "else") and w.strip()]
-            except ValueError:
-                continue                # unbalanced quotes: LIGGGHTS says so itself
-        for line in lines:
+        for line in _if_commands(cmd) if cmd.name == "if" else [cmd.text]:
             w = line.split()
             why = host_fix_refusal(line)
             if why:
@@ -225,16 +219,21 @@ def _check_delete(cmd: Command) -> None:
                       "collision log): add 'compress no' to the command")
 
 
-def _check_if(cmd: Command) -> None:
-    """The commands inside ``if ... then "..." [elif ... "..."] [else "..."]`` run inside
-    LIGGGHTS, where the host cannot couple them: a ``run`` there would be uncoupled steps
-    whose collisions are never seen, and a refused command would slip through."""
+def _if_commands(cmd: Command) -> list[str]:
+    """The commands inside ``if ... then "..." [elif ... "..."] [else "..."]`` (and elif's
+    conditions, which name no command); none for unbalanced quotes (LIGGGHTS says so itself)."""
     try:
         words = cmd.words
     except ValueError:
-        return                          # unbalanced quotes: LIGGGHTS says so itself
-    inner = [w.split(None, 1)[0] for w in words[2:] if w not in ("then", "elif", "else") and w.strip()]
-    for name in inner:
+        return []
+    return [w for w in words[2:] if w not in ("then", "elif", "else") and w.strip()]
+
+
+def _check_if(cmd: Command) -> None:
+    """The commands inside an ``if`` run inside LIGGGHTS, where the host cannot couple them:
+    a ``run`` there would be uncoupled steps whose collisions are never seen, and a refused
+    command would slip through."""
+    for name in (line.split(None, 1)[0] for line in _if_commands(cmd)):
         if name == "run" or name in REFUSED:
             why = ("the host couples every run itself: write the run outside the if (give its steps as a variable)"
                    if name == "run" else REFUSED[name])
