@@ -193,7 +193,7 @@ WALLS = {   # the wall, the pull towards it, where the sphere starts: 0.1 mm fro
 }
 
 
-def run_curved(tmp_path, wall, late, entry):
+def run_curved(tmp_path, wall, late, entry, ranks=1):
     """The sphere against ``wall`` (defined after the first run with ``late``, its fix heat/gran
     too with late = "both") in plain LIGGGHTS and in the host (with or without a
     [[walls]] entry at the wall's 350 K): (plain LIGGGHTS' Temp [K] and heat/gran's heatFlux
@@ -219,8 +219,10 @@ def run_curved(tmp_path, wall, late, entry):
     if late == "both":                    # the Temp the host adds at the first run: heat/gran's 300 K
         scene = scene.replace('temperature = 0.0\n', 'temperature = 300.0\n', 1)
     (case / "case.toml").write_text(scene if entry else scene.split("[materials.steel]")[0] + "[output]" + scene.split("[output]")[1])
-    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--out", str(case / "out")],
-                       capture_output=True, text=True, cwd=ROOT, timeout=600)
+    mpirun = ["mpirun", "--oversubscribe", "-np", str(ranks)] if ranks > 1 else []
+    r = subprocess.run(mpirun + [sys.executable, "-m", "pyhost", "run", str(case), "--out", str(case / "out")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=600,
+                       env=dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1"))
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     with open(case / "out" / "collisions.csv") as f:
         rows = list(csv.DictReader(f))
@@ -231,9 +233,10 @@ M_C = 2500.0 * 4.0 / 3.0 * np.pi * 0.001**3 * 840.0      # the sphere's m c [J/K
 DT = 1e-6
 
 
-@pytest.mark.parametrize("wall, late", [("zcylinder", False), ("zcylinder", True), ("zplane", True),
-                                        ("zcylinder", "both")])
-def test_heat_gran_through_a_cylinder_or_a_wall_defined_late_is_counted_as_liggghts_conducts_it(wall, late, tmp_path):
+@pytest.mark.parametrize("wall, late, ranks", [("zcylinder", False, 1), ("zcylinder", True, 1), ("zplane", True, 1),
+                                               ("zcylinder", "both", 1), ("zcylinder", True, 2)])
+def test_heat_gran_through_a_cylinder_or_a_wall_defined_late_is_counted_as_liggghts_conducts_it(wall, late, ranks,
+                                                                                                 tmp_path):
     """A sphere pulled against a hot wall (350 K) from 0.1 mm, 10 + 5,190 steps of 1 us: it touches
     it once (v0 = 0.044 m/s) and bounces off; the wall a zcylinder, or a wall defined after the
     script's first run (after the host's contact recorder: its heat/gran flux was added after
@@ -242,10 +245,12 @@ def test_heat_gran_through_a_cylinder_or_a_wall_defined_late_is_counted_as_liggg
     recorder did not follow a heat/gran that came after the first run: the same). No [[walls]] entry: the host changes no temperature, so its
     heat_from_script_walls is plain LIGGGHTS' sum of heatFlux dt over the steps, to 1e-12, and
     its m c (T_end - T_0) to 1e-10 (the dumped Temp near 300 K carries its 3.9 mK rise to about
-    1e-11), and the sphere ends at plain LIGGGHTS' Temp."""
-    T, q, summary, rows, out = run_curved(tmp_path, wall, late, entry=False)
+    1e-11), and the sphere ends at plain LIGGGHTS' Temp; the late zcylinder on two MPI ranks too
+    (each rank's recorder given anew after the wall)."""
+    T, q, summary, rows, out = run_curved(tmp_path, wall, late, entry=False, ranks=ranks)
     conducted = DT * float(np.sum(q))
-    print(f"{wall}{' after the first run' if late else ''}{', heat/gran too' if late == 'both' else ''}: {len(rows)} wall collisions; plain LIGGGHTS: sum "
+    print(f"{wall}{' after the first run' if late else ''}{', heat/gran too' if late == 'both' else ''}, {ranks} "
+          f"rank(s): {len(rows)} wall collisions; plain LIGGGHTS: sum "
           f"heatFlux dt {conducted:.15e} J, m c dT {M_C * (T[-1] - T[0]):.15e} J; host heat_from_script_walls "
           f"{summary['heat_from_script_walls']:.15e} J, balance {summary['energy_balance_error']:.2e}")
     assert len(rows) == 1 and conducted > 1e-6
