@@ -20,6 +20,15 @@ from pathlib import Path
 from pyhost.walls import PRIMITIVES
 
 
+HOST_PREFIX = "collheat_"
+"""The ids of the fixes, computes and variables the host adds to a script (the contact
+recorder ``collheat_events``, the fluid force ``collheat_fluid``, variables it evaluates): a
+script's own may not begin so."""
+
+HOST_ID_COMMANDS = ("fix", "unfix", "fix_modify", "compute", "uncompute", "compute_modify", "variable")
+"""Commands whose second word is the id of a fix, compute or variable."""
+
+
 class ScriptError(ValueError):
     """A script the host cannot run, naming the file and the line."""
 
@@ -101,10 +110,13 @@ def script_commands(path: str | Path, folder: str | Path | None = None, _depth: 
     return commands
 
 
-def read_script(path: str | Path, folder: str | Path | None = None) -> list[Command]:
+def read_script(path: str | Path, folder: str | Path | None = None, temperatures: bool = True) -> list[Command]:
     """The commands of a LIGGGHTS script the host runs (``script_commands``), with what the
-    host cannot run refused before any engine time (see the module doc)."""
+    host cannot run refused before any engine time (see the module doc), and what would
+    remove or replace a fix the host adds (``_check_host_ids``; ``temperatures``: whether
+    the host adds the Temp property at the first run, where the script has none)."""
     commands = script_commands(path, folder)
+    _check_host_ids(commands, temperatures)
     for cmd in commands:
         if cmd.name == "jump":
             _check_jump(cmd, Path(folder) if folder is not None else Path(path).parent)
@@ -123,8 +135,50 @@ def read_script(path: str | Path, folder: str | Path | None = None) -> list[Comm
                               "supported: the collision heat models and the energy balance take each atom for a "
                               "sphere of its own mass, and a clump's spheres carry the whole clump's")
         if cmd.name == "run":
-            parse_run(cmd)              # 'run ... every' and other forms refused before any engine time
+            parse_run(cmd)              # its forms the host cannot run refused before any engine time
     return commands
+
+
+def host_fix_refusal(line: str) -> str | None:
+    """Why a LIGGGHTS command would remove or replace a fix, compute or variable of the host's
+    (its id begins with HOST_PREFIX, or it unfixes Temp), or None."""
+    w = line.split()
+    if len(w) < 2 or w[0] not in HOST_ID_COMMANDS:
+        return None
+    if w[1].startswith(HOST_PREFIX):
+        return (f"'{line}': ids beginning with '{HOST_PREFIX}' are the host's own (its contact recorder fix "
+                "collheat_events, its fluid force fix collheat_fluid, the variables it evaluates): the script may "
+                "not define, remove or change one (without the recorder no collision is seen); give the script's "
+                "own another id")
+    if w[:2] == ["unfix", "Temp"]:
+        return ("'unfix Temp': the particles' temperatures live in the Temp property (the host's collision heat "
+                "and energy balance read and write it): the script may not remove it")
+    return None
+
+
+def _check_host_ids(commands: list[Command], temperatures: bool) -> None:
+    """A script's command that would remove or replace what the host adds (Dem.prepare, at
+    the first run) is refused with its file and line: without the contact recorder no
+    collision is seen and no heat moves, and the run would still end as done. Refused: a
+    fix, compute or variable (its definition, unfix, uncompute, modify) whose id begins with
+    HOST_PREFIX, inside an 'if' too; 'unfix Temp' (the particles' temperatures live in that
+    property, the host's or heat/gran's); and a 'fix Temp' after the first run when the host
+    added that property there (no fix Temp or heat/gran before it)."""
+    first_run = next((k for k, c in enumerate(commands) if c.name == "run"), len(commands))
+    own_temp = any(c.name == "fix" and (c.text.split()[1:2] == ["Temp"] or c.text.split()[3:4] == ["heat/gran"]
+                                        or c.text.split()[3:5] == ["property/atom", "Temp"])
+                   for c in commands[:first_run])      # (as Dem.prepare decides)
+    for k, cmd in enumerate(commands):
+        for line in _if_commands(cmd) if cmd.name == "if" else [cmd.text]:
+            w = line.split()
+            why = host_fix_refusal(line)
+            if why:
+                raise ScriptError(f"{cmd.where()}: {why}")
+            if w[:2] == ["fix", "Temp"] and k > first_run and temperatures and not own_temp:
+                raise ScriptError(f"{cmd.where()}: '{line}': the host adds 'fix Temp all property/atom Temp' at "
+                                  f"the script's first run ({commands[first_run].where()}), where the script has "
+                                  "none: this would replace it and the temperatures it holds; define the script's "
+                                  "fix Temp before its first run")
 
 
 def check_types(commands: list[Command], materials: dict, where: str) -> None:
@@ -230,6 +284,17 @@ def if_branches(cmd: Command) -> tuple[list[str], list[list[str]]]:
     if len(branches) == len(conditions):
         branches.append([])
     return conditions, branches
+
+
+def _if_commands(cmd: Command) -> list[str]:
+    """The commands inside an ``if``'s branches, those of the ifs among them too."""
+    found = []
+    for branch in if_branches(cmd)[1]:
+        for text in branch:
+            found.append(text)
+            if text.split(None, 1)[0] == "if":
+                found += _if_commands(Command(text, cmd.file, cmd.line))
+    return found
 
 
 BOX = ("create_box", "read_data", "read_restart")

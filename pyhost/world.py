@@ -204,14 +204,28 @@ def user_script(scene):
             if w.fix not in known:
                 raise SceneError(f"{scene.path}: walls[{k}].fix: the script has no fix wall/gran {w.fix!r} "
                                  f"before its first run; its walls: {', '.join(known) or 'none'}")
-            for mesh in range(max(len(known[w.fix].meshes), 1)):
-                word = info.conducting_temperature(w.fix, mesh)    # the script's, at which its heat/gran conducts
-                T = dem.value(word) if word is not None and w.temperature > 0 else None
+            meshes = known[w.fix].meshes
+            words = [info.conducting_temperature(w.fix, mesh) for mesh in range(max(len(meshes), 1))]
+            # the script's, at which its heat/gran conducts (None: it does not)
+            Ts = [dem.value(word) if word is not None and w.temperature > 0 else None for word in words]
+            for mesh, T in enumerate(Ts):
                 if T is not None and T != w.temperature:
+                    each = ", ".join(f"{m} {'no temperature' if t is None else f'{t:g} K'}" for m, t in zip(meshes, Ts))
                     raise SceneError(f"{scene.path}: walls[{k}].temperature: {w.temperature:g} K, where the script "
                                      f"gives wall {w.fix!r} {T:g} K (its fix heat/gran conducts at it): "
-                                     "one wall, one temperature")
+                                     "one wall, one temperature" + (
+                                         f"; its meshes: {each} (one fix wall/gran holds all of a script's meshes "
+                                         "in LIGGGHTS 3.8: give those with a temperature the entry's, or leave the "
+                                         "wall out of [[walls]])" if len(meshes) > 1 else ""))
                 named[w.fix, mesh] = (materials.index(w.material), w.temperature if w.temperature > 0 else np.nan)
+            if w.temperature > 0 and info.heat_gran and any(T is not None for T in Ts) and None in Ts \
+                    and (w.fix, "meshes") not in told:
+                told.add((w.fix, "meshes"))
+                print(f"LIGGGHTS wall {w.fix!r}: the script's fix heat/gran conducts through its meshes "
+                      + ", ".join(m for m, T in zip(meshes, Ts) if T is not None) + f" at {w.temperature:g} K and "
+                      "not through " + ", ".join(m for m, T in zip(meshes, Ts) if T is None) + " (no temperature "
+                      f"in the script): collisions with every one get the models' heat from {w.temperature:g} K")
+            for mesh, word in enumerate(words):
                 if word is not None and w.temperature == 0 and (w.fix, mesh) not in told:
                     print(f"LIGGGHTS wall {w.fix!r}: adiabatic for collision heat, though the script's fix heat/gran "
                           f"conducts through it at {word} K: give its [[walls]] entry that temperature for the "
@@ -275,7 +289,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         script, particles = box_world(scene, out, start, resume and resume["restart"])
         variables = {}
     particles["resume"] = resume
-    commands = read_script(script, scene.folder)
+    commands = read_script(script, scene.folder, effects["particle_temperatures"])
     if scene.scripted:
         check_types(commands, scene.materials, str(scene.path))
     inputs = fingerprints(scene, commands)      # at the start: a restart checks that none changed since

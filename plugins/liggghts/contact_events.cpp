@@ -725,6 +725,24 @@ void *collheat_events_attach(void *ptr, const char *fix_id)
     return rec;
 }
 
+// Whether a fix wall/gran comes after the recorder's fix (a script's wall defined after the
+// first run, where the host added the recorder): its post_force, which adds its heat/gran flux
+// to heatFlux, runs after the recorder's, whose sum of that flux would miss it.
+int collheat_events_walls_after(void *handle) { return !static_cast<Recorder *>(handle)->walls_before_me(); }
+
+// The recorder goes on with another `fix external pf/callback` (its fix given anew, after the
+// walls: pyhost.engines.events.ContactEvents.keep_last); its contacts and histories stay.
+// -1 if there is no such fix.
+int collheat_events_reattach(void *handle, const char *fix_id)
+{
+    Recorder *rec = static_cast<Recorder *>(handle);
+    const int k = rec->lmp->modify->find_fix(fix_id);
+    if (k < 0 || std::strcmp(rec->lmp->modify->fix[k]->style, "external") != 0) return -1;
+    rec->fix = static_cast<FixExternal *>(rec->lmp->modify->fix[k]);
+    rec->fix->set_callback(callback, rec);
+    return 0;
+}
+
 // The primitive walls: n `fix wall/gran ... primitive` ids and the partner code of their
 // contacts (WALL_BASE + the host's wall index); -1 if one is not such a fix.
 int collheat_events_primitives(void *handle, int n, const char **ids, const double *code)

@@ -140,18 +140,10 @@ class EnergyBalance(Effect):
 
     def check_heat_gran(self) -> None:
         """At each of a script's runs: a fix heat/gran that appeared has its capacities checked
-        (``check_capacities``). One defined after the first run came too late for the contact
-        compute's heatFlux column (LIGGGHTS refuses the column without the fix), so its
-        conduction during collisions cannot be taken back: said once, with what it means."""
-        loop = self.loop
-        if not loop.dem.info.heat_gran:
-            return
-        self.check_capacities()
-        if not loop.dem.has_heat_flux() and "heat_gran_late" not in loop.warned:
-            loop.warned.add("heat_gran_late")
-            print(f"warning: fix heat/gran {loop.dem.info.heat_gran!r} comes after the script's first run: its "
-                  "conduction through a contact during the collision's model time is not taken back, so that "
-                  "stretch is counted by both (see heat_gran_undone: 0); define it before the first run to avoid it")
+        (``check_capacities``); the event recorder follows one defined after the first run from
+        the run after it (``Dem.follow_heat_gran``)."""
+        if self.loop.dem.info.heat_gran:
+            self.check_capacities()
 
     def check_capacities(self) -> None:
         """A script's fix heat/gran integrates Temp with its own thermalCapacity: it must be the

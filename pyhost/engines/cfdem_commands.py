@@ -28,6 +28,8 @@ from pathlib import Path
 
 from foamlib import FoamFile
 
+from pyhost.script import host_fix_refusal
+
 SMALL = 1e-15
 """OpenFOAM's SMALL, which CFDEM adds before each floor of a time over the coupling interval."""
 
@@ -194,6 +196,9 @@ def read_commands(case: str | Path, couple_every: int) -> list[CaseCommand]:
         if text.split()[:1] in (["run"], ["rerun"]):
             raise CaseCommandsError(f"{where}: '{text.strip()}': steps run outside the coupling, which the host "
                                     "does not follow (its time, contacts and heat); give them to the script")
+        why = host_fix_refusal(text.strip())
+        if why:
+            raise CaseCommandsError(f"{where}: {why}")
         when, times = _when(props, where)
         found.append(CaseCommand(text.rstrip(), stamp=stamp, when=when, file=str(path), line=line, times=times))
     return found

@@ -62,6 +62,7 @@ class Dem:
         self.info = ScriptInfo()
         self.log = log
         self.events = None        # the contact event recorder (pyhost.engines.events), if asked for
+        self.heat = False         # whether the particles have temperatures (prepare)
         self._warnings = set()    # LIGGGHTS warnings already shown
         self._pending = None      # under MPI: the last gathered atoms, their T and v as gathered
         self._counts = None       # under MPI: atoms per rank in the last gather
@@ -247,8 +248,8 @@ class Dem:
         if contacts:
             from pyhost.engines.events import ContactEvents, RankEvents
             self.events = ContactEvents(self.lmp) if self.link is None else RankEvents(self.lmp, self.link)
-            if heat and self.info.heat_gran:
-                self.events.conduction(self.info.heat_gran, HEAT_GRAN_WINDOW)
+            self.heat = heat
+            self.follow_heat_gran()
         if then:
             self.commands(list(then))
         self.run(0)
@@ -501,6 +502,15 @@ class Dem:
             raise ScriptError(f"the script sets no 'fix ... property/global {prop} ...', which the host needs")
         return fix
 
+    def follow_heat_gran(self) -> None:
+        """With particle temperatures, the event recorder follows the script's fix heat/gran
+        (``ContactEvents.conduction``): from the first run, or from the run after the script
+        defines it later (CFDEM's packedBedTemp does): its walls' conduction is counted in the
+        balance from then on, and its share during the collisions that begin from then on is
+        taken back."""
+        if self.events is not None and self.heat and self.info.heat_gran and not self.has_heat_flux():
+            self.events.conduction(self.info.heat_gran, HEAT_GRAN_WINDOW)
+
     def has_heat_flux(self) -> bool:
         """Whether heat/gran's flux through each contact reaches the host (the event
         recorder's flux histories)."""
@@ -511,7 +521,14 @@ class Dem:
         """The primitive and mesh walls, for the event recorder, with their contact codes; of
         the ``heated`` ones ((fix, mesh) whose collisions the host gives heat), those through
         which the script's fix heat/gran conducts (a temperature in the script) keep its flux
-        through each new contact (``wall_conduction``). Returns their codes."""
+        through each new contact (``wall_conduction``). Returns their codes. The recorder's
+        fix comes after every wall's (``ContactEvents.keep_last``), and follows a fix heat/gran
+        defined since the last run (``follow_heat_gran``)."""
+        self.follow_heat_gran()
+        if self.events.keep_last():
+            self._pending = None
+            self.log("the host's contact recorder (fix collheat_events) given anew after the script's walls "
+                     "defined since the first run: it sums heat/gran's flux through their contacts after they add it")
         primitive = [(fix, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items() if w.primitive is not None]
         if not self.events.primitives(*(zip(*primitive) if primitive else ([], []))):
             raise ScriptError(f"the primitive walls {', '.join(f for f, _ in primitive)}: one is not a fix wall/gran "

@@ -69,6 +69,8 @@ _DECLARATIONS = {
     "collheat_events_forget": (None, [_vp, _int, _c.POINTER(_c.c_int64)]),
     "collheat_events_meshes_by_history": (_int, [_vp]),
     "collheat_events_heat_gran_heat": (None, [_vp, _dp]),
+    "collheat_events_walls_after": (_int, [_vp]),
+    "collheat_events_reattach": (_int, [_vp, _c.c_char_p]),
 }
 IMPOSED, MOVED = 1, 2      # the flags column
 HEAD = 4
@@ -117,6 +119,22 @@ class ContactEvents:
         out = (_c.c_double * 2)()
         self.lmp.helper.collheat_events_heat_gran_heat(self.handle, out)
         return out[0], out[1]
+
+    def keep_last(self) -> bool:
+        """The recorder's fix given anew after every fix wall/gran, if a script defined one after
+        it (after the first run): LIGGGHTS calls the fixes' post_force in their order, and a
+        wall's adds heat/gran's flux through its contacts after the recorder summed the flux of
+        the step (the walls' heat went uncounted: an energy balance broken at the end). The
+        recorder adds no force, so the trajectory is the same; its contacts and histories stay.
+        Returns whether it moved (the next run sets up anew, as after any command)."""
+        h = self.lmp.helper
+        if not h.collheat_events_walls_after(self.handle):
+            return False
+        self.lmp.command(f"unfix {self.fix}")
+        self.lmp.command(fix_command(self.fix))
+        if h.collheat_events_reattach(self.handle, self.fix.encode()):
+            raise RuntimeError(f"could not attach the contact event recorder to fix {self.fix} again")
+        return True
 
     def restitution(self, keys, speed, normal) -> None:
         """Separation speeds [m/s] to impose on open contacts (``pyhost.collisions.contact_keys``)
@@ -303,6 +321,9 @@ class RankEvents:
 
     def wall_conduction(self, meshes: bool, params) -> bool:
         return all(self._all("wall_conduction", meshes, np.asarray(params)))
+
+    def keep_last(self) -> bool:
+        return self._all("keep_last")
 
     def prime(self) -> None:
         self._all("prime")

@@ -320,11 +320,20 @@ class Liggghts:
             raise ValueError(f"steps must be >= 0, got {steps}")
         self._ahead = []
         line = f"run {steps} post no" if self._changed else f"run {steps} pre no post no"
-        if self._changed and self._new:     # the set-up is tried (bad input), unless only commands run
+        set_up = self._changed and self._new
+        if set_up:                          # the set-up is tried (bad input), unless only commands run
             self._tried(lambda: self._call("run 0 post no"), line)     # before came since the last run;
         elif not self._changed:             # what fails while stepping returns. Mesh walls keep the bins
             self.helper.collheat_keep_mesh_bins(self.ptr)   # of their triangles (plugins/liggghts/run_chunks.cpp)
-        self._execute(line, LiggghtsFailed, what="during the run, at step {step}")
+        start = self.step
+        try:
+            self._execute(line, LiggghtsFailed, what="during the run, at step {step}")
+        except LiggghtsFailed:
+            # on several ranks no copy tried the set-up: an error before the first step (LIGGGHTS
+            # counts a step at its start) is the set-up's, bad input as it is serially
+            if set_up and not self.check and self.step == start:
+                raise LiggghtsError(f"LIGGGHTS refused '{line}': {self.failed}") from None
+            raise
         self._changed = self._new = False
 
     def _call(self, line: str, is_file: bool = False) -> int:

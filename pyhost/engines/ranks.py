@@ -215,10 +215,10 @@ class Follower:
         self.lmp.context(text)
 
     def do_run(self, steps) -> None:
-        from pyhost.engines.liggghts import LiggghtsFailed
+        from pyhost.engines.liggghts import LiggghtsError
         try:
             self.lmp.run(steps)
-        except LiggghtsFailed:
+        except LiggghtsError:
             pass                  # rank 0 has the same error and reports it; orders go on
 
     def do_set_up_next(self) -> None:

@@ -383,3 +383,50 @@ def test_a_processor_grid_for_other_ranks_is_left_out(tmp_path):
     r, without = run(plain, script, toml())
     assert r.returncode == 0 and with_grid["collisions"] > 20
     assert with_grid["collisions"] == without["collisions"] and with_grid["particle_wall"] == without["particle_wall"]
+
+
+@pytest.mark.parametrize("command, message", [
+    ("unfix collheat_events", "ids beginning with 'collheat_' are the host's own"),
+    ("fix collheat_events all nve/sphere", "ids beginning with 'collheat_' are the host's own"),
+    ("compute collheat_pairs all pair/gran/local id", "ids beginning with 'collheat_' are the host's own"),
+    ('if "1 > 0" then "unfix collheat_events"', "ids beginning with 'collheat_' are the host's own"),
+    ("unfix Temp", "'unfix Temp': the particles' temperatures live in the Temp property"),
+    ("fix Temp all property/atom Temp scalar yes yes no 500.0", "the host adds 'fix Temp all property/atom Temp' at")])
+def test_a_script_may_not_remove_or_replace_the_hosts_fixes(tmp_path, command, message):
+    """The host adds its contact recorder (fix collheat_events) and, where the script has none,
+    the Temp property at the first run. A script that unfixed the recorder after it ran on to
+    exit 0 with 244 collisions instead of 397 and no heat moved. Now such a command (its id
+    with the host's prefix, or Temp) is refused when the script is read, before any engine
+    time: exit 2 naming the file and line."""
+    script = header() + "fix gravi all gravity 9.81 vector 0 0 -1\nrun 100\n" + command + "\nrun 100\n"
+    r, s = run(tmp_path, script, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert f"in.run:{len(script.splitlines()) - 1}: " in r.stderr and message in r.stderr, r.stderr[-2000:]
+    assert s is None and "host adds to the script" not in r.stdout      # refused before LIGGGHTS ran
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_two_mesh_wall_fixes_are_refused_with_exit_2_on_any_number_of_ranks(tmp_path, ranks):
+    """Two fix wall/gran over meshes, which LIGGGHTS refuses at a run's set-up ('More than one
+    wall of type mesh'): exit 2 serially (the set-up is tried in a forked copy first), and
+    on two ranks, where no copy tries it, it was exit 3 'simulation failed at step 0'. Plain
+    'liggghts -in' refuses the same script with the same ERROR line."""
+    if ranks > 1 and shutil.which("mpirun") is None:
+        pytest.fail("no mpirun: tools/setup.sh --engines installs it")
+    (tmp_path / "floor.stl").write_text(FLOOR)
+    (tmp_path / "roof.stl").write_text(FLOOR.replace(" 0.001\n", " 0.019\n"))
+    script = header().replace("fix walls all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n",
+                              "fix cad all mesh/surface file floor.stl type 1\n"
+                              "fix cad2 all mesh/surface file roof.stl type 1\n"
+                              "fix floor all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n"
+                              "fix roof all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad2\n")
+    script += "run 100\n"
+    refusal = "ERROR: Fix wall/gran (id floor): More than one wall of type 'mesh' is not supported"
+    (tmp_path / "in.run").write_text(script)
+    native = subprocess.run(["liggghts", "-in", "in.run", "-log", "none"], cwd=tmp_path, capture_output=True,
+                            text=True, errors="replace", timeout=120)     # (its banner is not all UTF-8)
+    assert refusal in native.stdout
+    r, s = run(tmp_path, script, toml(), ranks=ranks)
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert f"in.run:{len(script.splitlines())} (the first run): LIGGGHTS refused" in r.stderr and refusal in r.stderr
+    assert s is None

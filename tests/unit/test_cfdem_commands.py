@@ -89,6 +89,8 @@ def test_compose_numbers_labels_and_the_coupling_interval():
      "asks for more 'number' or 'label' words than"),
     ("liggghtsCommandModels ( runLiggghts execute );\nexecuteProps1 { command ( run 100 ); runFirst on; }",
      "'run 100': steps run outside the coupling"),
+    ("liggghtsCommandModels ( runLiggghts execute );\nexecuteProps1 { command ( unfix collheat_events ); runFirst on; }",
+     "'unfix collheat_events': ids beginning with 'collheat_' are the host's own"),
     ("liggghtsCommandModels ( runLiggghts execute );\nexecuteProps1 { command ( print hi ); runFirst off; runLast off;"
      " runEveryCouplingStep off; runEveryWriteStep off; }", "needs startTime, endTime and timeInterval"),
 ])
