@@ -244,17 +244,28 @@ def load_scene(path) -> Scene:
 
 def _cfdem_script(dem, data, path, file):
     """A CFDEM case names the LIGGGHTS script its coupling runs (``coupling_script``): the
-    scene's dem.script when the scene gives none and places no particles of its own."""
+    scene's dem.script when the scene gives none and places no particles of its own; a
+    dem.script that names another file is refused, as a disagreeing drag law is."""
     fluid = data.get("fluid")
     case = fluid.get("case") if isinstance(fluid, dict) else None
-    if dem.script or "particles" in data or not isinstance(case, str) or not case:
+    if "particles" in data or not isinstance(case, str) or not case:
         return dem
     from pyhost.engines.fluid_case import coupling_script
 
-    found = coupling_script(path.resolve().parent / case)
+    try:
+        found = coupling_script(path.resolve().parent / case)
+    except ValueError as exc:
+        raise SceneError(f"{file}: fluid.case: {exc}") from None
     if found is None:
         return dem
     script, where = found
+    if dem.script:
+        given = path.resolve().parent / dem.script
+        if given.resolve() != script.resolve():
+            raise SceneError(f"{file}: dem.script: {dem.script!r} ({given.resolve()}), but {where} names "
+                             f"{script.resolve()}, which CFDEM's coupling runs: remove dem.script to take the "
+                             "case's, or make them agree")
+        return dem
     if not script.is_file():
         raise SceneError(f"{file}: dem.script: not given, and {where} names {script}, which does not exist")
     return dataclasses.replace(dem, script=os.path.relpath(script, path.resolve().parent))

@@ -26,8 +26,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from foamlib import FoamFile
-
+from pyhost.engines.fluid_case import cfdem_dict, entry_line
 from pyhost.script import host_fix_refusal
 
 SMALL = 1e-15
@@ -132,14 +131,6 @@ def _when(props, where: str) -> tuple[str, tuple]:
                                 "timeInterval (coupling steps) as numbers") from None
 
 
-def _line(path: Path, name: str) -> int:
-    """The line of ``path`` where the entry ``name`` begins (for messages), 0 if not found."""
-    for k, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
-        if line.split("//")[0].split()[:1] == [name]:
-            return k
-    return 0
-
-
 def read_commands(case: str | Path, couple_every: int) -> list[CaseCommand]:
     """The commands of a CFDEM case's constant/liggghtsCommands besides its coupled run, in the
     order CFDEM runs them; [] without the file. CaseCommandsError for a model the host does not
@@ -147,7 +138,7 @@ def read_commands(case: str | Path, couple_every: int) -> list[CaseCommand]:
     path = Path(case) / "constant" / "liggghtsCommands"
     if not path.is_file():
         return []
-    f = FoamFile(path)
+    f = cfdem_dict(path)
     models = [str(m) for m in (f.get("liggghtsCommandModels") or [])]
     if "runLiggghts" not in models:
         raise CaseCommandsError(f"{path}: liggghtsCommandModels has no runLiggghts: CFDEM would not run the DEM "
@@ -159,8 +150,7 @@ def read_commands(case: str | Path, couple_every: int) -> list[CaseCommand]:
                                     f"without {model} the run would not be the case's (remove it to run without)")
         name = f"{model}Props{i}" if model == "execute" else f"{model}Props"
         props = f.get(name)
-        props = props.as_dict() if props is not None else None
-        line = _line(path, name if props is not None else "liggghtsCommandModels")
+        line = entry_line(path, name if props is not None else "liggghtsCommandModels")
         where = f"{path}:{line} {name if props is not None else model}"
         if model == "runLiggghts":
             if props and props.get("runFirst") is True:

@@ -233,6 +233,45 @@ CFDEM_KNOWN = {"fluid.drag": CFDEM_DRAG, "fluid.void_fraction": CFDEM_VOID_FRACT
 """The scene keys a CFDEM model name goes to, with the names the host has."""
 
 
+def entry_line(path: Path, name: str) -> int:
+    """The line of ``path`` where the entry ``name`` begins (for messages), 0 if not found."""
+    for k, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+        if line.split("//")[0].split()[:1] == [name]:
+            return k
+    return 0
+
+
+def _values(d, keys=()):
+    """(keys, value) of every entry of a parsed dictionary, its sub-dictionaries' too."""
+    for key in d:
+        value = d[key]
+        if isinstance(value, dict) or hasattr(value, "as_dict"):
+            yield from _values(value, keys + (str(key),))
+        else:
+            yield keys + (str(key),), value
+
+
+def cfdem_dict(path: Path) -> dict:
+    """A CFDEM dictionary (couplingProperties, liggghtsCommands) read strictly, as a plain dict:
+    a file OpenFOAM cannot parse is named with foamlib's line and column, and an entry whose
+    value runs on over several words is refused naming the file and its line: a ';' missing at
+    the end of a line joins the next entry to it ('couplingInterval 100' then 'voidFractionModel
+    divided;' read as one entry, so that voidFractionModel was missing and the host ran CFDEM's
+    default, centre, with exit 0; CFDEM itself stops there). None of CFDEMcoupling-PUBLIC's
+    tutorials has such an entry. ValueError (bad input) for either."""
+    try:
+        parsed = FoamFile(path).as_dict()
+    except ValueError as exc:               # foamlib's FoamFileDecodeError
+        raise ValueError(f"{path}: not a dictionary OpenFOAM reads: {exc}") from None
+    for keys, value in _values(parsed):
+        if isinstance(value, tuple) and any(isinstance(v, str) for v in value[1:]):
+            words = " ".join(str(v) for v in value)
+            raise ValueError(f"{path}:{entry_line(path, keys[-1])}: entry {' '.join(keys)} reads '{words}': a ';' "
+                             f"is missing at the end of its line, and the next entry is read as part of its value "
+                             "(CFDEM would stop there)")
+    return parsed
+
+
 def _entry(f, name: str):
     """A dictionary's entry ``name`` as OpenFOAM finds it: the key itself, else the last
     "(regex)" key that matches it whole (ErgunTestMPI: ``"(twoWayMPIProps|M2MProps)"``)."""
@@ -262,7 +301,7 @@ def coupling_properties(case: str | Path) -> dict[str, tuple[str, str, object]]:
     path = Path(case) / "constant" / "couplingProperties"
     if not path.is_file():
         return {}
-    f = FoamFile(path)
+    f = cfdem_dict(path)
     found = {}
     models = [str(m) for m in (f.get("forceModels") or [])]
     drags = [m for m in models if m.endswith("Drag") and m != "noDrag"]
@@ -330,7 +369,7 @@ def coupling_script(case: str | Path) -> tuple[Path, str] | None:
     path = Path(case) / "constant" / "couplingProperties"
     if not path.is_file():
         return None
-    f = FoamFile(path)
+    f = cfdem_dict(path)
     exchange = str(f.get("dataExchangeModel", ""))
     script = (_entry(f, f"{exchange}Props") or {}).get("liggghtsPath")
     if not script:
@@ -358,7 +397,7 @@ def cfdem_unsupported(case: str | Path) -> str | None:
     coupling = Path(case) / "constant" / "couplingProperties"
     if not coupling.is_file():
         return None
-    f = FoamFile(coupling)
+    f = cfdem_dict(coupling)
     model = str(f.get("voidFractionModel", ""))
     forces = [str(m) for m in (f.get("forceModels") or []) if str(m).endswith("IB")]
     if model in ("IB", "bigParticle") or forces:

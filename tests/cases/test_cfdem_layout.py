@@ -439,3 +439,47 @@ def test_the_cases_liggghtsCommands_on_two_ranks_as_serially(tmp_path):
     grid = next(line for line in log.splitlines() if "MPI processor grid" in line).split("MPI")[0].split()
     assert int(grid[0]) * int(grid[2]) * int(grid[4]) == 2
     assert results[2] == results[1]
+
+
+COUPLING = ('FoamFile\n{\n    version 2.0;\n    format ascii;\n    class dictionary;\n    object couplingProperties;\n}\n'
+            'dataExchangeModel twoWayMPI;\ncouplingInterval 100;\nvoidFractionModel divided;\n'
+            'twoWayMPIProps\n{\n    liggghtsPath "../DEM/in.liggghts_run";\n}\n')
+
+
+@pytest.mark.parametrize("damage, message", [
+    # a ';' lost at the end of a line: the next entry read as part of this one's value
+    (lambda t: t.replace("couplingInterval 100;", "couplingInterval 100"),
+     r"couplingProperties:9: entry couplingInterval reads '100 voidFractionModel divided': a ';' is missing"),
+    (lambda t: t.replace("twoWayMPIProps\n{\n", "twoWayMPIProps\n{\n    verbose true\n"),
+     r"couplingProperties:13: entry twoWayMPIProps verbose reads 'True liggghtsPath \"\.\./DEM/in\.liggghts_run\"'"),
+    # the case names another script than the scene's
+    (lambda t: t.replace("in.liggghts_run", "in.liggghts_other"),
+     r"dem.script: '\.\./DEM/in\.liggghts_run' .* but .*couplingProperties twoWayMPIProps liggghtsPath names "
+     r".*in\.liggghts_other, which CFDEM's coupling runs"),
+])
+def test_cfdem_dictionaries_are_read_strictly(tmp_path, damage, message):
+    """A CFDEM couplingProperties with a missing ';' was read with the next entry swallowed
+    (voidFractionModel lost: CFDEM's default centre ran, exit 0), and a liggghtsPath naming
+    another script than dem.script went unreported: both refused before any engine, naming
+    the file, its line and the entry."""
+    from pyhost.scene import SceneError, load_scene
+
+    cfd = cfdem_case(tmp_path)
+    (cfd.parent / "DEM" / "in.liggghts_other").write_text(SCRIPT.format(d=D, rho_p=RHO_P))
+    (cfd / "constant" / "couplingProperties").write_text(damage(COUPLING))
+    with pytest.raises((SceneError, ValueError), match=message):
+        load_scene(cfd / "case.toml")
+
+
+def test_an_unclosed_list_in_liggghtscommands_is_named_in_that_file(tmp_path):
+    """liggghtsCommands with a list not closed: the message names that file (it named only
+    case.toml), with foamlib's line."""
+    from pyhost.scene import SceneError, load_scene
+
+    cfd = cfdem_case(tmp_path)
+    (cfd / "constant" / "liggghtsCommands").write_text(
+        'FoamFile\n{\n    version 2.0;\n    format ascii;\n    class dictionary;\n    object liggghtsCommands;\n}\n'
+        'liggghtsCommandModels\n(\n    runLiggghts\n;\n')
+    with pytest.raises(SceneError, match=r"case.toml: fluid.case: .*constant/liggghtsCommands: not a dictionary "
+                                         r"OpenFOAM reads: .*line"):
+        load_scene(cfd / "case.toml")
