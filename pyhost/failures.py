@@ -37,6 +37,22 @@ class ParticlesLost(SimulationFailed):
         self.ids, self.position, self.velocity, self.time, self.cause = ids, position, velocity, time, cause
 
 
+class LeftTheMesh(SimulationFailed):
+    """Particles the DEM still holds are outside the fluid's mesh: the DEM's walls and box do
+    not keep them where the fluid is."""
+
+
+def left_the_mesh(ids, x, v, t: float) -> LeftTheMesh:
+    """The failure of the particles ``ids`` at positions ``x`` [m], moving at ``v`` [m/s], found
+    outside the fluid mesh at time ``t`` [s], naming the first and the likely cause."""
+    return LeftTheMesh(
+        f"t = {t:.6g} s: {len(ids)} particle(s) are outside the fluid's mesh, e.g. particle {int(ids[0])} at "
+        f"{np.round(x[0], 6).tolist()} m moving at {np.round(v[0], 4).tolist()} m/s: the DEM's walls and box do not "
+        "keep the particles inside the fluid's mesh (a wall the mesh has and the DEM lacks, such as a hopper's "
+        "funnel or a pipe's side given only to the fluid; a DEM box larger than the mesh; a particle through a "
+        "soft DEM wall): give the DEM the mesh's walls (fix mesh/surface with the same STL, or a wall/gran)")
+
+
 class DragUnresolved(SimulationFailed):
     """The gas's drag, held over a coupling interval, would carry particles past the gas speed
     within it: K interval / m > 1."""

@@ -64,7 +64,7 @@ import numpy as np
 from bench_host import Clocked
 from pyhost.world import simulate, start_fluid
 from pyhost.dem_input import place_particles
-from pyhost.effects.fluid import layer_pressure_drop
+from pyhost.effects.fluid import layer_pressure_drop, upwards
 from pyhost.output import read_collisions
 from pyhost.scene import load_scene
 
@@ -99,7 +99,7 @@ class Probe:
         if len(self.F) % self.snap == 0:
             self.snaps.append({"t": len(self.F) * self.dt, "x": np.array(x, copy=True), "v": np.array(v, copy=True)})
         self.F.append(forces[:, 2].sum())
-        self.dp.append(layer_pressure_drop(self.fluid))
+        self.dp.append(layer_pressure_drop(self.fluid, upwards(self.fluid)))
         self.overhead += time.perf_counter() - t0
         self.fluid.advance(duration, steps)
         return forces
@@ -212,7 +212,7 @@ def fluid_step_table(base, weight: float, out: Path, end: float = 0.004) -> None
             for _ in range(round(end / (k * dt))):
                 fluid.couple(p.position, p.velocity, 2.0 * p.radius, k * dt, substeps)
             F = fluid.particle_forces(p.position, p.velocity, 2.0 * p.radius)[:, 2].sum()
-            print(f"{k * dt / substeps:14.1e} | {100 * F / weight:6.1f} | {layer_pressure_drop(fluid):7.1f}", flush=True)
+            print(f"{k * dt / substeps:14.1e} | {100 * F / weight:6.1f} | {layer_pressure_drop(fluid, upwards(fluid)):7.1f}", flush=True)
         finally:
             fluid.stop()
 

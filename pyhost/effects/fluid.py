@@ -12,7 +12,8 @@ import numpy as np
 
 from plugins import convection
 from pyhost.effects import Effect, by_id
-from pyhost.failures import drag_unresolved
+from pyhost.engines.openfoam import OutsideMesh
+from pyhost.failures import drag_unresolved, left_the_mesh
 from pyhost.output import VtkSeries
 
 TOTAL_TOLERANCE = 1e-4
@@ -38,13 +39,23 @@ def overlapping(setting: str, dem_ranks: int, fluid_ranks: int) -> bool:
     return dem_ranks == 1 and 1 + fluid_ranks <= len(os.sched_getaffinity(0))
 
 
-def layer_pressure_drop(fluid) -> float:
-    """Mean pressure [Pa] of the fluid's lowest cell layer less that of its highest. Layers
-    are matched with a tolerance: cell centres of one layer differ in their last digits."""
+def upwards(fluid) -> np.ndarray:
+    """The unit vector against the case's gravity (+z where it has none)."""
+    g = fluid.gravity()
+    norm = float(np.linalg.norm(g))
+    return -g / norm if norm > 0 else np.array([0.0, 0.0, 1.0])
+
+
+def layer_pressure_drop(fluid, up) -> float:
+    """Mean pressure [Pa] of the fluid's lowest cell layer along ``up`` less that of its
+    highest. Layers are matched with a tolerance: cell centres of one layer differ in their
+    last digits (NaN for a mesh one cell high)."""
     p, _ = fluid.fields()
-    z = fluid.cell_centres[:, 2]
-    tol = 1e-6 * (z.max() - z.min())
-    return float(p[z < z.min() + tol].mean() - p[z > z.max() - tol].mean())
+    h = fluid.cell_centres @ up
+    tol = 1e-6 * (h.max() - h.min())
+    if not tol > 0:
+        return math.nan
+    return float(p[h < h.min() + tol].mean() - p[h > h.max() - tol].mean())
 
 
 class FluidExchange(Effect):
@@ -62,6 +73,7 @@ class FluidExchange(Effect):
                        if loop.scene.output.vtk else None)
         self.force = (np.zeros(0, np.int64), np.zeros((0, 3)))   # ids and force [N] of the last coupling
         self.gas_energy0 = 0.0
+        self.up = upwards(fluid)
         link = loop.dem.link
         self.overlap = overlapping(loop.scene.fluid.overlap, 1 if link is None else link.size, loop.scene.fluid.ranks)
 
@@ -81,7 +93,10 @@ class FluidExchange(Effect):
         lo, hi, periodic = loop.dem.box()
         x = np.where(periodic, lo + np.mod(atoms.x - lo, hi - lo), atoms.x)   # the DEM wraps only at re-neighbouring
         interval = loop.every["couple"] * loop.dem.dt
-        forces = self.fluid.particle_forces(x, atoms.v, 2.0 * atoms.radius)
+        try:
+            forces = self.fluid.particle_forces(x, atoms.v, 2.0 * atoms.radius)
+        except OutsideMesh as exc:          # a failed simulation (exit 3), not bad input
+            raise left_the_mesh(atoms.id[exc.index], x[exc.index], atoms.v[exc.index], loop.t) from None
         failure = drag_unresolved(atoms.id, self.fluid.exchange, atoms.mass, 2.0 * atoms.radius, interval,
                                   loop.dem.dt, loop.t)
         if failure is not None:
@@ -119,17 +134,21 @@ class FluidExchange(Effect):
         return self.bed_state(atoms) + (self.gas_state() if self.convection else ())
 
     def bed_state(self, atoms) -> tuple:
-        """The fluid columns of history.csv: the superficial inlet velocity [m/s]; the pressure
-        drop the particles cause [Pa], mean p of the lowest cell layer less that of the highest,
-        less the fluid's own hydrostatic head between them; the bed height [m], twice the mean
-        particle centre height above the box floor (exact for a uniform bed)."""
+        """The fluid columns of history.csv, heights taken against gravity (``upwards``): the
+        superficial inlet velocity [m/s] (NaN for a user's case, whose inlet the host does not
+        set); the pressure drop the particles cause [Pa], mean p of the lowest cell layer less
+        that of the highest, less the fluid's own hydrostatic head between them; the bed height
+        [m], twice the mean particle centre height above the box's lowest face (exact for a
+        uniform bed)."""
         loop = self.loop
-        z = self.fluid.cell_centres[:, 2]
-        head = self.fluid.rho * self.fluid.gravity()[2] * (z.max() - z.min())
-        floor = loop.dem.box()[0][2]
+        up = self.up
+        h = self.fluid.cell_centres @ up
+        head = self.fluid.rho * float(self.fluid.gravity() @ up) * (h.max() - h.min())
+        lo, hi, _ = loop.dem.box()
+        floor = float(np.sum(np.minimum(lo * up, hi * up)))
         inlet = math.nan if loop.scene.fluid.case else float(loop.scene.fluid.inlet_at(loop.t))
-        return (inlet, layer_pressure_drop(self.fluid) + head,
-                2.0 * float(np.mean(atoms.x[:, 2] - floor)) if len(atoms.x) else math.nan)
+        return (inlet, layer_pressure_drop(self.fluid, up) + head,
+                2.0 * float(np.mean(atoms.x @ up - floor)) if len(atoms.x) else math.nan)
 
     def gas_state(self) -> tuple:
         """The gas columns of history.csv: the heat-capacity weighted mean gas temperature [K],

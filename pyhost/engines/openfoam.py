@@ -60,6 +60,14 @@ class FluidError(RuntimeError):
     """The fluid solver failed; the message ends with the tail of its log."""
 
 
+class OutsideMesh(ValueError):
+    """Points outside the fluid mesh (``locate``): ``index``, their indices in the request."""
+
+    def __init__(self, message, index):
+        super().__init__(message)
+        self.index = index
+
+
 class FluidCaseError(ValueError):
     """The solver refused the case's input before its first step (its exit code 2, e.g. a
     boundary condition it cannot honour): bad input, with the tail of its log."""
@@ -386,7 +394,7 @@ class FluidSolver:
         """Cell of each position (global index over ranks), fluid velocity (m/s) and kinematic
         pressure gradient (m/s^2) there, interpolated as controlDict's
         ``particleInterpolation`` says (default ``cell``). ValueError if a point is outside
-        (``strict``), else cell -1 there. ``point_set``: which set they are (0 the particles'
+        (OutsideMesh, ``strict``), else cell -1 there. ``point_set``: which set they are (0 the particles'
         centres, 1 the divided rule's points in them): the solver tries each point's cell of
         the last request of its set first."""
         x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 3)
@@ -405,8 +413,8 @@ class FluidSolver:
             u[mine], gradp[mine] = ur[mine], gr[mine]
         if strict and np.any(cell < 0):
             lost = np.flatnonzero(cell < 0)
-            raise ValueError(f"{len(lost)} point(s) outside the fluid mesh, e.g. index {lost[0]} "
-                             f"at {x[lost[0]].tolist()} m")
+            raise OutsideMesh(f"{len(lost)} point(s) outside the fluid mesh, e.g. index {lost[0]} "
+                              f"at {x[lost[0]].tolist()} m", lost)
         return cell, u, gradp
 
     @_exchange
