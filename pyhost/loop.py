@@ -144,7 +144,8 @@ class Coupling:
                                         self.frames) if e is not None]
         if events:                           # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
-        self.program, self.run_left = {}, 0  # where the script stands at the run under way (Program.state), its steps to go
+        self.program, self.run_left = None, 0  # the script's input loop (Program: where it stands at the run
+                                               # under way, kept by a checkpoint), the run's steps to go
         self.inputs = {}                     # SHA-256 of each file the run read, at its start (a restart checks them)
         self.extend = 0.0                    # run --extend [s] (a checkpoint keeps it)
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
@@ -290,7 +291,8 @@ class Coupling:
         for effect in self.effect_list:    # every frame a log names on disk
             effect.flush()
         values = dict(clock=self.clock, t_step=self.t_step, t_begin=self.t_begin, steps=self.steps, t=self.t,
-                      totals=self.totals, warned=sorted(self.warned), program=self.program, run_left=self.run_left,
+                      totals=self.totals, warned=sorted(self.warned), run_left=self.run_left,
+                      program=self.program.state() if self.program else {},
                       mesh_motion=self.dem.mesh_motion_times(), randoms=self.dem.random_states(),
                       insertions=self.dem.insertion_progress())
         arrays, logs = {}, {}
@@ -493,7 +495,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, f
             else:
                 coupling.update_walls(walls_of(dem))
                 coupling.check_heat_gran()
-            coupling.program = program.state()
+            coupling.program = program
             if how == "interrupted":
                 n = int(resume["run_left"])
                 log(f"{cmd.where()}: restarted in this run, {n} steps to go")
