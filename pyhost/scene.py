@@ -290,16 +290,45 @@ FLUID_CASE_FILES = ("system/controlDict", "system/fvSchemes", "system/fvSolution
 
 def _user_fluid_case(fluid, path, file, energy: bool):
     """A user's OpenFOAM case: the files collheatFoam reads (0/T for the gas energy), a mesh or
-    a blockMeshDict, and no scene key that the case itself decides."""
+    a blockMeshDict, and no scene key that the case itself decides. A case written for another
+    solver (``fluid_case.adopt_other_solver``: a phase's suffix, 0.orig, no turbulenceProperties)
+    is checked as the host will run it: adapted in a scratch copy, the messages naming the
+    case's folder."""
+    import shutil
+    import tempfile
+
+    from pyhost.engines.fluid_case import adopt_other_solver, case_phase
+
     folder = path.resolve().parent / fluid.case
     if not folder.is_dir():
         raise SceneError(f"{file}: fluid.case: no such folder {str(folder)!r}")
+    if not (case_phase(folder) or not (folder / "0").is_dir() or not (folder / "constant/turbulenceProperties").is_file()):
+        return _check_fluid_case(fluid, folder, file, energy)
+    with tempfile.TemporaryDirectory(prefix="collheat-case-") as tmp:
+        copy = Path(tmp) / folder.name
+        shutil.copytree(folder, copy, ignore=lambda d, names: [n for n in names if n.startswith(("processor", "log."))
+                                                                or (Path(d) == folder and n not in ("0", "0.orig",
+                                                                    "constant", "system"))])
+        adopt_other_solver(copy)
+        try:
+            return _check_fluid_case(fluid, copy, file, energy)
+        except SceneError as exc:
+            raise SceneError(str(exc).replace(str(copy), f"{folder} (as the host adapts it)")) from None
+
+
+def _check_fluid_case(fluid, folder, file, energy: bool):
+    """``_user_fluid_case``'s checks on ``folder``, the user's case or its adapted copy."""
+    from pyhost.engines.foam_case_check import check_case, solution_gaps
+
     missing = [f for f in FLUID_CASE_FILES + (("0/T",) if energy else ()) if not (folder / f).is_file()]
     if not (folder / "constant" / "polyMesh" / "owner").is_file() and not (folder / "system" / "blockMeshDict").is_file():
         missing.append("constant/polyMesh or system/blockMeshDict")
+    if (folder / "system" / "snappyHexMeshDict").is_file() and not (folder / "constant/polyMesh/owner").is_file():
+        missing.append("constant/polyMesh: the case's mesh is snappyHexMesh's (system/snappyHexMeshDict), which the "
+                       "host does not run (it runs blockMesh only): run blockMesh and snappyHexMesh in the case first")
+    missing += solution_gaps(folder, file, energy)
     if missing:
-        raise SceneError(f"{file}: fluid.case: {folder} lacks what collheatFoam needs: {', '.join(missing)}")
-    from pyhost.engines.foam_case_check import check_case
+        raise SceneError(f"{file}: fluid.case: {folder} lacks what collheatFoam needs: {'; '.join(missing)}")
     check_case(folder, file, fluid.ranks, energy)
     from pyhost.engines.fluid_case import case_density
     try:

@@ -65,8 +65,8 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
     on the box's sides at their fixed temperature, the other walls adiabatic."""
     from foamlib import FoamFile
 
-    from pyhost.engines.fluid_case import (add_final_solvers, adopt_mean_velocity_force, adopt_piso,
-                                           adopt_void_fraction, box_case, case_density, start_time)
+    from pyhost.engines.fluid_case import (add_final_solvers, adopt_mean_velocity_force, adopt_other_solver,
+                                           adopt_piso, adopt_void_fraction, box_case, case_density, start_time)
     from pyhost.engines.openfoam import FluidSolver
 
     f = scene.fluid
@@ -83,6 +83,8 @@ def start_fluid(scene, folder: Path, restart: Path | None = None):
             shutil.move(str(p), folder / p.name)
         if earlier:
             earlier[0].parent.rmdir()
+        for note in adopt_other_solver(folder):
+            print(f"fluid case: {note}")
         adopt_void_fraction(folder)
         add_final_solvers(folder)
         if adopt_piso(folder):

@@ -407,6 +407,39 @@ case = "."
 """ + MATERIAL.format(density=density, cp=cp, T=T, types="[1]")
 
 
+def foam_scene(box: list, region: list, gravity: list) -> str:
+    """The case.toml a user writes into one of OpenFOAM's lagrangian tutorials to run its gas
+    under the host's own particles (a box scene over the mesh's extent): 20 glass beads of 1 mm
+    at 350 K placed in ``region``, 10 ms. The case's particle cloud is not used."""
+    return f"""[effects]
+fluid = true
+contact_heat = "A"
+[fluid]
+case = "."
+[materials.glass]
+density = 2500.0
+youngs_modulus = 63e9
+poisson_ratio = 0.22
+yield_stress = 500e6
+heat_capacity = 840.0
+conductivity = 1.0
+dem = {{ youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }}
+[[particles]]
+material = "glass"
+count = 20
+radius = 5e-4
+temperature = 350.0
+region = {region}
+[domain]
+box = {box}
+gravity = {gravity}
+[time]
+dem_step = 4e-6
+couple_every = 50
+end = 0.01
+"""
+
+
 def liggghts_scene(script: str, density: float, *, cp: float = 840.0, T: float = 300.0, types: str = "[1]") -> str:
     """The case.toml beside a Debian LIGGGHTS tutorial's script."""
     return (f'[dem]\nscript = "{script}"\n\n[effects]\ncontact_heat = "A"\n'
@@ -466,6 +499,27 @@ TUTORIALS = [
     Tutorial("hydrogel", "liggghts", "hydrogel_multicontact", ".",          # walls at ${sizeX}, a piston;
              liggghts_scene("in.hydrogel_default", 11.5, types="[1, 2]"),  # its data file's density
              checks=liggghts_checks),
+    # OpenFOAM's lagrangian tutorials' gas as a box scene's fluid case (the phase's suffix, 0.orig,
+    # gzipped dictionaries adapted in the host's copy: fluid_case.adopt_other_solver)
+    Tutorial("MPPICFoam_column", "openfoam", "lagrangian/MPPICFoam/column", ".",
+             foam_scene([-0.0092, 0.0092, -0.0092, 0.0092, 0.0, 0.3], [-0.008, 0.008, -0.008, 0.008, 0.2, 0.28],
+                        [0, 0, -9.81])),
+    Tutorial("MPPICFoam_Goldschmidt", "openfoam", "lagrangian/MPPICFoam/Goldschmidt", ".",
+             foam_scene([-0.0075, 0.0075, -0.075, 0.075, 0.0, 0.45], [-0.006, 0.006, -0.07, 0.07, 0.3, 0.44],
+                        [0, 0, -9.81])),
+    Tutorial("MPPICFoam_injectionChannel", "openfoam", "lagrangian/MPPICFoam/injectionChannel", ".",
+             foam_scene([0.0, 0.53, -0.06, 0.06, -0.005, 0.005], [0.1, 0.3, -0.02, 0.02, -0.004, 0.004], [0, 0, 0])),
+    Tutorial("DPMFoam_Goldschmidt_gas", "openfoam", "lagrangian/DPMFoam/Goldschmidt", ".",
+             foam_scene([-0.0075, 0.0075, -0.075, 0.075, 0.0, 0.45], [-0.006, 0.006, -0.07, 0.07, 0.3, 0.44],
+                        [0, 0, -9.81])),
+    Tutorial("MPPICFoam_cyclone", "openfoam", "lagrangian/MPPICFoam/cyclone", ".",      # a snappyHexMesh mesh
+             foam_scene([-0.55, 0.55, -0.55, 0.55, -1.0, 1.1], [-0.3, 0.3, -0.3, 0.3, 0.5, 1.0], [0, 0, -9.81]),
+             refused="the case's mesh is snappyHexMesh's (system/snappyHexMeshDict), which the host does not run"),
+    Tutorial("icoUncoupled_hopper", "openfoam", "lagrangian/icoUncoupledKinematicParcelFoam/hopper/hopperEmptying",
+             ".", foam_scene([0.0, 0.3, -0.0779423, 0.5, 0.0, 0.0062], [0.01, 0.29, 0.3, 0.45, 0.001, 0.0052],
+                             [0, -9.81, 0]),      # its gas is given, not solved: no p, no solvers
+             refused="lacks what collheatFoam needs: 0/p; system/fvSolution solvers p; system/fvSolution solvers U; "
+                     "system/fvSolution PIMPLE (or PISO) dictionary"),
     Tutorial("Goldschmidt", "openfoam", "lagrangian/DPMFoam/Goldschmidt", "host", "",       # DPMFoam's own
              changes=[dpmfoam_import(0.05)], checks=goldschmidt_checks),
     Tutorial("post:heatTransfer_1", "liggghts", "heatTransfer_1", ".", liggghts_scene("in.heatGran", 8000.0, cp=10.0,

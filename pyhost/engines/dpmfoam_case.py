@@ -55,6 +55,7 @@ import numpy as np
 from foamlib import FoamFile
 
 from plugins.dem.hertz import effective_modulus, hertz_collision_time, restitution_of_tsuji_alpha
+from pyhost.engines.fluid_case import drop_phase
 
 DRAG = {"ErgunWenYuDrag": "gidaspow", "WenYuDrag": "wenyu"}
 """DPMFoam's drag models the host has, by the host's law names (plugins/drag)."""
@@ -288,10 +289,6 @@ def dem_step(cloud: Cloud, deltaT: float, impact_speed: float = 1.0) -> tuple[fl
     return deltaT / n, n
 
 
-def _suffixless(text: str, phase: str) -> str:
-    return re.sub(rf"(?<=[A-Za-z0-9_)])\.{re.escape(phase)}\b", "", text) if phase else text
-
-
 def convert(case: str | Path, out: str | Path, impact_speed: float = 1.0, hot_below: float | None = None,
             temperatures: tuple[float, float] = (400.0, 300.0)) -> dict:
     """Write ``out`` (CFD/, DEM/in.liggghts, DEM/particles.data, case.toml) from the DPMFoam
@@ -328,14 +325,14 @@ def convert(case: str | Path, out: str | Path, impact_speed: float = 1.0, hot_be
                     or "polyMesh" in src.parts):        # built again from blockMeshDict, its patches retyped
                 continue
             rel = str(src.relative_to(case)).removesuffix(".gz")        # OpenFOAM reads either
-            dst = cfd / _suffixless(rel, cloud.phase)
+            dst = cfd / drop_phase(rel, cloud.phase)
             dst.parent.mkdir(parents=True, exist_ok=True)
             try:
                 with gzip.open(src, "rt") if src.suffix == ".gz" else open(src) as f:
                     text = f.read()
             except (UnicodeDecodeError, gzip.BadGzipFile):
                 raise DpmfoamError(f"{src}: not a text file (the importer reads OpenFOAM's ascii files)") from None
-            dst.write_text(_suffixless(text, cloud.phase))
+            dst.write_text(drop_phase(text, cloud.phase))
     block = FoamFile(cfd / "system" / "blockMeshDict")
     boundary = block["boundary"]
     retyped = [name for name, entry in boundary if entry.get("type") == "wall" and name not in cloud.gas_walls]

@@ -15,6 +15,7 @@ at ``T_inlet``, outlets zeroGradient (T0 for backflow), walls adiabatic unless
 """
 from __future__ import annotations
 
+import gzip
 import math
 import re
 import shutil
@@ -504,3 +505,91 @@ def add_final_solvers(case: str | Path) -> list[str]:
         f["solvers"][final] = entry
         added.append(final)
     return added
+
+
+def drop_phase(text: str, phase: str) -> str:
+    """``text`` with a phase's suffix dropped from the names it follows (``U.air`` -> ``U``,
+    ``alphaPhi.air`` -> ``alphaPhi``, ``U.airFinal`` -> ``UFinal``): collheatFoam's names for a
+    case of OpenFOAM's particle solvers (MPPICFoam, DPMFoam), which name the gas's fields
+    after its phase."""
+    return re.sub(rf"(?<=[A-Za-z0-9_)])\.{re.escape(phase)}(?=Final\b|\b)", "", text) if phase else text
+
+
+def case_phase(case: str | Path) -> str:
+    """The gas phase's name a case of OpenFOAM's particle solvers gives (transportProperties'
+    ``continuousPhase``), '' for a single-phase case."""
+    props = Path(case) / "constant" / "transportProperties"
+    if not props.is_file():
+        return ""
+    found = re.search(r"^\s*continuousPhase\s+(\w+)\s*;", props.read_text(errors="replace"), re.M)
+    return found.group(1) if found else ""
+
+
+SOLVER_SCHEMES = {"div(alphaPhi,U)": ("Gauss", "linearUpwindV", "grad(U)"),
+                  "div(((alpha*nuEff)*dev2(T(grad(U)))))": ("Gauss", "linear")}
+"""The divergence schemes collheatFoam's momentum equation asks for (UEqn.H: the convection of
+U by alphaPhi, the deviatoric stress of the laminar or turbulent gas), with what the host writes
+into a copied case whose fvSchemes has neither nor a default: MPPICFoam's and DPMFoam's own
+choices (their tutorials' fvSchemes)."""
+
+
+def adopt_other_solver(case: str | Path) -> list[str]:
+    """A copied case written for another OpenFOAM solver, made collheatFoam's in place; returns
+    what was changed, one line each (printed as notes):
+
+    - a phase's suffix (MPPICFoam, DPMFoam: ``continuousPhase air``) dropped from every file
+      name and text of 0/, constant/ and system/ but the particle cloud's (``U.air`` -> ``U``,
+      ``turbulenceProperties.air`` -> ``turbulenceProperties``, ``phi.air`` in an
+      ``inletOutlet`` -> ``phi``, ``rho.air`` -> ``rho``);
+    - the particle cloud's files (kinematicCloud*, *CloudProperties) removed: the particles
+      are the DEM's;
+    - 0.orig copied to 0 where the case keeps its fields there (OpenFOAM's tutorials restore it
+      in their Allrun); gzipped dictionaries (``blockMeshDict.gz``) unpacked, which OpenFOAM
+      reads either way and the host's checks read plain;
+    - constant/turbulenceProperties written laminar where the case has none;
+    - fvSchemes' divergence schemes collheatFoam asks for (``SOLVER_SCHEMES``) added where the
+      case has neither them nor a default."""
+    case = Path(case)
+    notes = []
+    if not (case / "0").is_dir() and (case / "0.orig").is_dir():
+        shutil.copytree(case / "0.orig", case / "0")
+        notes.append("0/ copied from 0.orig (as the tutorial's Allrun does)")
+    for sub in ("0", "constant", "system"):
+        for path in sorted((case / sub).glob("*") if (case / sub).is_dir() else []):
+            if path.name.startswith("kinematicCloud") or "CloudProperties" in path.name:
+                path.unlink()           # the particle cloud's: the particles are the DEM's
+            elif path.suffix == ".gz":
+                path.with_suffix("").write_bytes(gzip.decompress(path.read_bytes()))
+                path.unlink()
+                notes.append(f"{path.relative_to(case)} unpacked")
+    phase = case_phase(case)
+    if phase:
+        renamed = []
+        for sub in ("0", "constant", "system"):
+            for path in sorted((case / sub).rglob("*") if (case / sub).is_dir() else []):
+                if not path.is_file() or "polyMesh" in path.parts:
+                    continue
+                text = path.read_text(errors="replace")
+                target = path.with_name(drop_phase(path.name, phase))
+                target.write_text(drop_phase(text, phase))
+                if target != path:
+                    path.unlink()
+                    renamed.append(f"{path.relative_to(case)} -> {target.relative_to(case)}")
+        notes.append(f"the gas phase '{phase}' (continuousPhase) read as collheatFoam's single gas: "
+                     f"its suffix dropped from names ({'; '.join(renamed) or 'no file renamed'})")
+    turbulence = case / "constant" / "turbulenceProperties"
+    if not turbulence.is_file() and (case / "constant").is_dir():
+        turbulence.write_text("FoamFile\n{\n    version 2.0;\n    format ascii;\n    class dictionary;\n"
+                              "    object turbulenceProperties;\n}\nsimulationType laminar;\n")
+        notes.append("constant/turbulenceProperties written with simulationType laminar (the case has none)")
+    schemes = case / "system" / "fvSchemes"
+    if schemes.is_file():
+        f = FoamFile(schemes)
+        div = f.get("divSchemes") or {}
+        if str(div.get("default", "none")).strip() == "none":
+            added = {k: v for k, v in SOLVER_SCHEMES.items() if k not in div}
+            if added:
+                f["divSchemes"] = {**dict(div), **added}
+                notes.append("fvSchemes divSchemes: " + "; ".join(f"{k} {' '.join(v)}" for k, v in added.items())
+                             + " added (collheatFoam's momentum equation asks for them)")
+    return notes

@@ -131,6 +131,34 @@ def check_fields(folder: Path, file: str, fields) -> None:
                                  + (f" (instead of {', '.join(map(repr, unused))}?)" if unused else ""))
 
 
+def solution_gaps(folder: Path, file: str, energy: bool) -> list[str]:
+    """What collheatFoam asks of system/fvSolution and the case lacks: a linear solver for p and
+    U (and T with the gas energy; their Final solvers the host adds in its copy), by name or a
+    quoted regular expression, and a PIMPLE (or PISO) dictionary. A case written for a solver
+    that moves no gas (icoUncoupledKinematicParcelFoam) has none of them."""
+    rel = "system/fvSolution"
+    if not (folder / rel).is_file():
+        return []
+    d = _read(folder, rel, file)
+    solvers = d.get("solvers") if isinstance(d.get("solvers"), dict) else {}
+    keys = [str(k) for k in solvers]
+
+    def solved(name: str) -> bool:
+        return name in keys or any(k.startswith('"') and _matches(k[1:-1], name) for k in keys)
+
+    gaps = [f"{rel} solvers {name}" for name in ("p", "U") + (("T",) if energy else ()) if not solved(name)]
+    if not any(isinstance(d.get(k), dict) for k in ("PIMPLE", "PISO")):
+        gaps.append(f"{rel} PIMPLE (or PISO) dictionary")
+    return gaps
+
+
+def _matches(pattern: str, name: str) -> bool:
+    try:
+        return re.fullmatch(pattern, name) is not None
+    except re.error:
+        return True             # a pattern Python cannot read: left to OpenFOAM
+
+
 def check_decomposition(folder: Path, file: str, ranks: int) -> None:
     """decomposeParDict cuts the mesh into ``ranks`` pieces (for a parallel fluid)."""
     rel = "system/decomposeParDict"
