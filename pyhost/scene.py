@@ -309,10 +309,15 @@ def _user_fluid_case(fluid, path, file, energy: bool):
         shutil.copytree(folder, copy, ignore=lambda d, names: [n for n in names if n.startswith(("processor", "log."))
                                                                 or (Path(d) == folder and n not in ("0", "0.orig",
                                                                     "constant", "system"))])
-        adopt_other_solver(copy)
         try:
+            try:
+                adopt_other_solver(copy)
+            except ValueError:          # a dictionary foamlib cannot read: the check names it, OpenFOAM's words
+                from pyhost.engines.foam_case_check import check_dictionaries
+                check_dictionaries(copy, file)
+                raise
             return _check_fluid_case(fluid, copy, file, energy)
-        except SceneError as exc:
+        except (SceneError, ValueError) as exc:
             raise SceneError(str(exc).replace(str(copy), f"{folder} (as the host adapts it)")) from None
 
 

@@ -223,8 +223,37 @@ def check_start(folder: Path, file: str) -> None:
                              f"{', '.join(missing)}")
 
 
+def check_dictionaries(folder: Path, file: str) -> None:
+    """Every dictionary of the case's system/, constant/ (not its polyMesh or surfaces) and 0/
+    reads as OpenFOAM reads it: one foamlib cannot parse is given to OpenFOAM's own
+    foamDictionary, and refused (SceneError) with OpenFOAM's words, file and line if it fails
+    there too (a '{' too many in fvSchemes stopped the solver at its start, exit 3; a file
+    foamlib alone cannot read is left to OpenFOAM)."""
+    import subprocess
+
+    from pyhost.engines.openfoam import foam_env
+
+    for sub in ("system", "constant", "0"):
+        for path in sorted((folder / sub).glob("*") if (folder / sub).is_dir() else []):
+            if not path.is_file() or path.suffix in (".gz", ".stl", ".obj"):
+                continue
+            try:
+                FoamFile(path).as_dict()
+                continue
+            except ValueError:
+                pass                # foamlib's FoamFileDecodeError: OpenFOAM decides
+            r = subprocess.run(["foamDictionary", str(path.relative_to(folder))], cwd=folder, capture_output=True,
+                               text=True, errors="replace", env=foam_env(), timeout=60)
+            if r.returncode != 0:
+                said = [ln.strip() for ln in r.stderr.splitlines() if ln.strip()]
+                start = next((k for k, ln in enumerate(said) if "FOAM FATAL" in ln), 0)
+                words = " ".join(ln for ln in said[start + 1:start + 3] if not ln.startswith("From "))
+                raise SceneError(f"{file}: fluid.case: {path}: OpenFOAM cannot read it: {words}")
+
+
 def check_case(folder: Path, file: str, ranks: int, energy: bool) -> None:
     """All the checks of the module doc (the files' presence is checked by the caller)."""
+    check_dictionaries(folder, file)
     props = _read(folder, "constant/transportProperties", file)
     where = f"{file}: fluid.case: {folder / 'constant/transportProperties'}"
     if _number(props.get("nu")) is None:

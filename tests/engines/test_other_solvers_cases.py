@@ -63,3 +63,17 @@ def test_a_case_the_host_cannot_run_is_refused_naming_all_it_lacks(tmp_path, nam
     with pytest.raises(SceneError) as err:
         load_scene(case / "case.toml")
     assert words in str(err.value) and f"{case} (as the host adapts it)" in str(err.value)
+
+
+def test_a_dictionary_openfoam_cannot_read_is_named_before_the_engines(tmp_path):
+    """A '{' too many in fvSchemes stopped the solver at its start (exit 3); now the scene is
+    refused naming the file and OpenFOAM's own words and line (foamDictionary decides where
+    foamlib cannot read a file)."""
+    from pyhost.scene import SceneError, load_scene
+
+    case = copy(tmp_path, "MPPICFoam_column")
+    schemes = case / "system" / "fvSchemes"
+    schemes.write_text(schemes.read_text().replace("gradSchemes\n{", "gradSchemes\n{{", 1))
+    with pytest.raises(SceneError, match=rf"{case} \(as the host adapts it\)/system/fvSchemes: OpenFOAM cannot read "
+                                         r"it: Found \{ but expected \} file: system/fvSchemes at line \d+"):
+        load_scene(case / "case.toml")

@@ -274,7 +274,7 @@ FLUID_CASES = {   # id: (changes of the valid user case, words the one-line mess
                                      + [foam_text("constant/polyMesh/boundary", POLYMESH)],
                                      ["0/U: boundaryField", "patch 'bottom'", "constant/polyMesh/boundary"]),
     "blockMeshDict not OpenFOAM": ([foam_text("system/blockMeshDict", BLOCKS.replace("(0 1 1));", "(0 1 1);"))],
-                                   ["system/blockMeshDict: not a valid OpenFOAM file", "line 2, column 10"]),
+                                   ["system/blockMeshDict: OpenFOAM cannot read it", "system/blockMeshDict at line 5"]),
     "block names a missing vertex": ([foam_text("system/blockMeshDict", BLOCKS.replace("VERTEX", "8"))],
                                      ["system/blockMeshDict: blocks", "from 0 to 7"]),
     "blockMeshDict without blocks": ([foam_edit("system/blockMeshDict", "blocks")], ["blockMeshDict: blocks: missing"]),
