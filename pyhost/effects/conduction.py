@@ -142,5 +142,7 @@ class LastingConduction(Effect):
                      conduction_owned_ends=np.array(list(self.owned.values()), float)))
 
     def restore(self, state: dict) -> None:
-        self.t_last = state["conduction_t"]
-        self.owned = dict(zip(state["conduction_owned_keys"].tolist(), state["conduction_owned_ends"].tolist()))
+        # (a checkpoint of a run without conduction: it starts at the restart)
+        self.t_last = state.get("conduction_t", self.loop.t)
+        self.owned = dict(zip(state.get("conduction_owned_keys", np.zeros(0, np.int64)).tolist(),
+                              state.get("conduction_owned_ends", np.zeros(0)).tolist()))

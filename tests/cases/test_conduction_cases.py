@@ -69,6 +69,7 @@ def scene(tmp_path: Path, name: str, contact_heat: str, end: float | None = None
     text = text.replace("restitution_feedback = true", "restitution_feedback = false")
     if end is not None:
         text = text.replace("end = 2e-3", f"end = {end!r}").replace("test_end = 1.5e-3", "")
+    text = text.replace("[output]\n", "[output]\nvtk = false\npictures = false\n")
     text += "\n[conduction]\nevery = 1\n"
     folder = tmp_path / name
     folder.mkdir()
@@ -97,3 +98,44 @@ def test_a_collision_owns_its_contact_for_t_coll(tmp_path):
     assert whole["heat_conducted_contact"] > 0.0
     for s in (whole, owned, alone):
         assert abs(s["energy_balance_error"]) < 1e-12
+
+
+def test_conduction_stopped_within_t_coll_restarts_bit_for_bit(tmp_path):
+    """The collision-and-contact run above stopped by SIGTERM at step 2540, inside the
+    collision's t_coll (it began at step 2501 and owns its contact to step 2572), and restarted
+    from the checkpoint: collisions.csv, history.csv and summary.json (heat_conducted_contact
+    included) equal to the last bit those of the run that wrote a periodic checkpoint there and
+    went on. The checkpoint keeps when the last update was and which contacts a collision owns."""
+    from test_user_scripts import restarts_bit_for_bit
+
+    case = scene(tmp_path, "case", "A")
+    whole = restarts_bit_for_bit(case, ("test_end = 1.5e-3", "test_end = 1.5e-3"), 2540 * 2e-7,
+                                 "checkpoint at t = 0.000508 s (step 2540)", 2540)
+    assert whole["heat_conducted_contact"] > 0.0 and whole["collisions"] == 1
+
+
+def test_a_pair_across_a_periodic_side_conducts_as_in_the_open(tmp_path):
+    """The pfp problem with x periodic and the box 10 mm long, the spheres placed so that they
+    face each other across the periodic side (6.52 mm apart inside the box, 3.48 mm through the
+    side): the same temperatures as the open case, to 1e-9 K, over its smoke run (30 s)."""
+    import shutil
+
+    folders = {}
+    for name, change in (("open", None), ("periodic", True)):
+        folder = tmp_path / name
+        shutil.copytree(CASES / "pfp-conduction", folder, ignore=shutil.ignore_patterns("output", "log.*"))
+        if change:
+            script = folder / "in.liggghts"
+            text = script.read_text().replace("boundary f f f", "boundary p f f")
+            text = text.replace("region box block 0 0.02", "region box block 0 0.01")
+            text = text.replace("create_atoms 1 single 0.0115 ", "create_atoms 1 single 0.008 ")
+            text = text.replace("create_atoms 2 single 0.01498 ", "create_atoms 2 single 0.00148 ")
+            script.write_text(text)
+        r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(folder), "--out", str(folder / "out"), "--test"],
+                           capture_output=True, text=True, cwd=ROOT, timeout=300)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        folders[name] = curves(folder / "out")
+    (t, cold, hot), (t_p, cold_p, hot_p) = folders["open"], folders["periodic"]
+    assert np.array_equal(t, t_p) and t[-1] == pytest.approx(30.0)
+    assert np.abs(cold - cold_p).max() < 1e-9 and np.abs(hot - hot_p).max() < 1e-9
+    assert cold[-1] - cold[0] > 1.0
