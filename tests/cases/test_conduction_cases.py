@@ -139,3 +139,23 @@ def test_a_pair_across_a_periodic_side_conducts_as_in_the_open(tmp_path):
     assert np.array_equal(t, t_p) and t[-1] == pytest.approx(30.0)
     assert np.abs(cold - cold_p).max() < 1e-9 and np.abs(hot - hot_p).max() < 1e-9
     assert cold[-1] - cold[0] > 1.0
+
+
+def test_contact_conduction_beside_a_scripts_heat_gran_is_refused(tmp_path):
+    """A script whose fix heat/gran conducts through the particles' contacts, with
+    contact_conduction asked for too: both would conduct through the same contacts. Exit 2,
+    naming the key, the fix and the file, before any step."""
+    import shutil
+
+    folder = tmp_path / "both"
+    shutil.copytree(CASES / "two-sphere-conduction", folder, ignore=shutil.ignore_patterns("output", "log.*"))
+    script = folder / "in.liggghts"
+    script.write_text(script.read_text().replace("timestep 0.1", (
+        "fix m5 all property/global thermalConductivity peratomtype 55.03674204 0.84070944\n"
+        "fix m6 all property/global thermalCapacity peratomtype 800.5329072 55.035486\n"
+        "fix heat all heat/gran initial_temperature 300\ntimestep 0.1")))
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(folder), "--out", str(folder / "out")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert (f"{folder / 'case.toml'}: effects.contact_conduction = 'mfix': the script's fix heat/gran 'heat' "
+            "conducts through the same contacts") in r.stderr
