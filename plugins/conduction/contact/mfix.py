@@ -20,9 +20,10 @@ def conductance(pair):
     order in the overlap delta). Zero for pairs apart (line 126).
 
     Batchelor, G.K., O'Brien, R.W., Proc. R. Soc. Lond. A 355 (1977) 313-333: for a contact
-    radius a much smaller than the radii and conductivities much above the gas', H = 2 k_eff a
-    (their eq. 4.8 gives 4 k a for one material; k_eff is k there). Musser, J., PhD thesis,
-    West Virginia University (2011).
+    radius a much smaller than the radii and conductivities much above the gas', each sphere
+    is a half-space fed through a circle of radius a, resistance 1/(4 k a); the two in series
+    give H = 4 a k_i k_j / (k_i + k_j) = 2 k_eff a. Musser, J., PhD thesis, West Virginia
+    University (2011).
 
     Valid for a static contact, a << R, and a gas much less conducting than the solid (the
     gas path is a gap model's). It takes the overlap as the DEM gives it: with a softened DEM
