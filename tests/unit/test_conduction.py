@@ -160,3 +160,19 @@ def test_exchange_in_a_network_conserves_energy_and_stays_bounded():
         assert T[mates].min() - 1e-9 <= T_new[p] <= T[mates].max() + 1e-9
     small = exchange(T, C, i, j, 1e-12 * G)
     assert np.allclose(small, 1e-12 * G * (T[j] - T[i]), rtol=1e-6)
+
+
+def test_rong_horio_small_sphere_inside_the_lens_conducts_as_mfix_does():
+    """A 0.1 mm sphere touching a 1 mm one lies wholly inside the lens: MFiX's RADIUS gives -1
+    (1 m in SI), so both faces conduct whole; the same conductance, to 1e-12, as MFiX's literal
+    steps with RD_OUT = -1 m."""
+    big, small, s = 1e-3, 1e-4, GAS.min_distance
+    d = big + small - 1e-9
+    H = GAP["rong_horio"].conductance(pair(d, r_i=small, r_j=big), GAS)
+    delta = big + small - d
+    x, y = delta / big, (delta + s) / big
+    o1 = big**2 * (x - x**2 / 2) / d
+    s1 = big**2 * (y - y**2 / 2) / (d - s) - o1
+    h1 = half_lens(np.sqrt(1.0 + (small - o1) ** 2), s1, o1, small) * small * GAS.conductivity
+    h2 = half_lens(np.sqrt(1.0 + (big - (delta - o1)) ** 2), s - s1, delta - o1, big) * big * GAS.conductivity
+    assert H == pytest.approx(h1 * h2 / (h1 + h2), rel=1e-12)

@@ -47,8 +47,10 @@ def conductance(pair, gas):
         S_1 = R_max^2 (y - y^2/2)/(d - s_min) - OLAP_1, y = (delta + s_min)/R_max;  S_2 = s_min - S_1,
         RLENS_1 = (RD_OUT^2 + (R_min - OLAP_1)^2)^(1/2),  RLENS_2 = (RD_OUT^2 + (R_max - OLAP_2)^2)^(1/2).
 
-    Where the smaller sphere lies wholly inside the lens (MFiX's RADIUS returns -1) RD_OUT is
-    R_min here: MFiX's caps at the sphere's face (R_out <= 1) give the same. Rong, D., Horio,
+    Where the smaller sphere lies wholly inside the lens, MFiX's RADIUS returns -1, a length
+    (1 cm or 1 m by its units) whose square exceeds every radius squared: both faces then
+    conduct whole (R_out capped at 1 in ``half_lens``). RD_OUT = R_max gives the same here,
+    whatever the units. Rong, D., Horio,
     M., "DEM simulation of char combustion in a fluidized bed", 2nd Int. Conf. on CFD in the
     Minerals and Process Industries, Melbourne (1999) 65-70; Musser, PhD thesis, WVU (2011).
 
@@ -62,7 +64,7 @@ def conductance(pair, gas):
     s = gas.min_distance
     near = delta > -R_max * gas.lens
     rd_out = circle_radius(R_max * (1.0 + gas.lens), R_min, d)
-    rd_out = np.where(rd_out < 0, R_min, rd_out)
+    rd_out = np.where(rd_out < 0, R_max, rd_out)
     x = delta / R_max
     olap_1 = R_max**2 * (x - 0.5 * x**2) / d
     olap_2 = delta - olap_1
