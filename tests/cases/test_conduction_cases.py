@@ -159,3 +159,29 @@ def test_contact_conduction_beside_a_scripts_heat_gran_is_refused(tmp_path):
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
     assert (f"{folder / 'case.toml'}: effects.contact_conduction = 'mfix': the script's fix heat/gran 'heat' "
             "conducts through the same contacts") in r.stderr
+
+
+def test_a_granular_gas_with_both_paths_keeps_its_balance_and_range(tmp_path):
+    """hot-cold-box (1000 steel spheres, periodic, hot and cold halves, model A) for 5 ms with
+    morris contact conduction and rong_horio gas gaps (air, 0.026 W/(m K)) updated every 10
+    steps: many particles with several partners at once. Energy balance to 1e-12, every
+    temperature within the starting range, heat through both paths."""
+    text = (CASES / "hot-cold-box" / "case.toml").read_text()
+    text = text.replace('contact_heat = "A"', 'contact_heat = "A"\ncontact_conduction = "morris"\n'
+                        'gap_conduction = "rong_horio"', 1)
+    text = text.replace("test_end = 0.01", "test_end = 0.005")
+    text = text.replace("[output]\n", "[output]\nvtk = false\npictures = false\n")
+    folder = tmp_path / "box"
+    folder.mkdir()
+    (folder / "case.toml").write_text(text + "\n[conduction]\nevery = 10\ngas_conductivity = 0.026\n")
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(folder), "--out", str(folder / "out"), "--test"],
+                       capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    s = json.loads((folder / "out" / "summary.json").read_text())
+    rows = list(csv.DictReader(open(folder / "out" / "history.csv")))
+    lo, hi = float(rows[0]["T_min"]), float(rows[0]["T_max"])
+    print(f"{s['collisions']} collisions, {s['heat_moved']:.4g} J by collisions, {s['heat_conducted_contact']:.4g} J "
+          f"through contacts, {s['heat_conducted_gap']:.4g} J through gas gaps; balance {s['energy_balance_error']:.2g}")
+    assert abs(s["energy_balance_error"]) < 1e-12
+    assert all(lo <= float(row["T_min"]) and float(row["T_max"]) <= hi for row in rows)
+    assert s["heat_conducted_contact"] > 0 and s["heat_conducted_gap"] > 0 and s["collisions"] > 1000
