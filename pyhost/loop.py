@@ -127,8 +127,8 @@ class Coupling:
         logs = resume["logs"] if resume else {}
         # the effects the scene asks for, in the order they act
         self.balance = EnergyBalance(self) if self.heat else None
-        self.conduction = LastingConduction(self) if self.effects["conduction"] else None
         self.collisions = CollisionHeat(self, walls, logs) if self.effects["contact_extraction"] else None
+        self.conduction = LastingConduction(self) if self.effects["conduction"] else None
         self.check_heat_gran()
         if resume is None and self.balance is not None:
             self.balance.begin(dem.atoms(True))

@@ -126,9 +126,9 @@ class CollisionHeat(Effect):
         """Whether this chunk's end needs the events taken now: a harvest, a frame or a
         checkpoint is due, or a fluid exchange that reads the temperatures (convection) or
         comes while a fix heat/gran conducts, or a lasting conduction update (which must know
-        every collision begun, to leave each its t_coll). A fluid exchange without either changes no
-        temperature and reads none: the events wait for the next of the others, in larger
-        batches (the heat moved is the same, collision after collision in their order)."""
+        every collision begun, to leave each its t_coll). A fluid exchange without either
+        changes no temperature and reads none: the events wait for the next of the others, in
+        larger batches (the heat moved is the same, collision after collision in their order)."""
         convects = self.loop.fluid_exchange is not None and self.loop.fluid_exchange.convection
         return any(due[k] for k in ("harvest", "frame", "checkpoint", "conduct")) or (
             due["couple"] and (convects or bool(self.dem.events.window)))
