@@ -1,6 +1,7 @@
 """Registries by name, one API for every kind of model the plugins hold: heat models A, B, C
 (``plugins.heat.models``), comparison heat models (``plugins.heat.comparison``), drag laws
-(``plugins.drag``) and Nusselt correlations (``plugins.convection.nusselt``).
+(``plugins.drag``), Nusselt correlations (``plugins.convection.nusselt``) and lasting
+conduction models (``plugins.conduction.contact``, ``plugins.conduction.gap``).
 
 One module per entry in a package, file name = key, each defining ``MODEL``; modules whose
 name starts with ``_`` are the package's helpers. A new model is one new file: the scene's

@@ -10,6 +10,8 @@ which runs the DEM in chunks and hands the particles to the effects the scene as
     CollisionHeat   every contact that begins is a collision: impact speed, plugin heat,
                     exchange in Temp; the model's restitution at its end if asked; a script's
                     fix heat/gran undone during t_coll (when collisions matter)
+    LastingConduction  every conduction.every steps: heat through lasting contacts (after
+                    each collision's t_coll) and gas gaps between particles (when asked for)
     FluidExchange   every coupling: fluid force on particles, particles' fraction to the fluid;
                     with convection, gas-particle heat over the interval (with a fluid)
     Frames          every frame: history.csv (each effect adds its columns), VTK
@@ -32,6 +34,7 @@ from pyhost.dem_input import script_dem_contacts
 from pyhost.effects.balance import EnergyBalance
 from pyhost.effects.case_commands import CaseCommands, case_commands
 from pyhost.effects.collisions import CollisionHeat
+from pyhost.effects.conduction import LastingConduction
 from pyhost.effects.fluid import FluidExchange
 from pyhost.effects.frames import Frames
 from pyhost.engines.dem import Dem
@@ -54,7 +57,7 @@ FRAME_EVERY = 1e-3
 def totals() -> dict:
     """The run's totals at its start (summary.json): the ``TOTALS`` of every effect that adds
     to them, present in the scene or not (a summary has the same keys whatever the scene)."""
-    return {key: value for effect in (CollisionHeat, EnergyBalance, CaseCommands, FluidExchange)
+    return {key: value for effect in (CollisionHeat, EnergyBalance, LastingConduction, CaseCommands, FluidExchange)
             for key, value in effect.TOTALS.items()}
 
 
@@ -125,6 +128,7 @@ class Coupling:
         # the effects the scene asks for, in the order they act
         self.balance = EnergyBalance(self) if self.heat else None
         self.collisions = CollisionHeat(self, walls, logs) if self.effects["contact_extraction"] else None
+        self.conduction = LastingConduction(self) if self.effects["conduction"] else None
         self.check_heat_gran()
         if resume is None and self.balance is not None:
             self.balance.begin(dem.atoms(True))
@@ -136,12 +140,13 @@ class Coupling:
                           if events else 0,
                           frame=0,                    # (set just below, and at each run of a script)
                           couple=scene.time.couple_every if fluid is not None else 0,
+                          conduct=scene.conduction.every if self.conduction is not None else 0,
                           checkpoint=round(scene.output.checkpoint / dem.dt) if scene.output.checkpoint else 0)
         self.every["frame"] = self.frame_every()
         self.case_commands = (case_commands(self, driven) if fluid is not None and scene.fluid.case  # a user's case's:
                               else None)                  # after the DEM's steps, before the fluid's exchange
-        self.effect_list = [e for e in (self.balance, self.collisions, self.case_commands, self.fluid_exchange,
-                                        self.frames) if e is not None]
+        self.effect_list = [e for e in (self.balance, self.collisions, self.conduction, self.case_commands,
+                                        self.fluid_exchange, self.frames) if e is not None]
         if events:                           # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
         self.program, self.run_left = None, 0  # the script's input loop (Program: where it stands at the run
@@ -237,6 +242,8 @@ class Coupling:
             due = {name: k and step % k == 0 for name, k in self.every.items()}
             if self.collisions is not None:
                 self.collisions.after_chunk(due)
+            if due["conduct"]:
+                self.conduction.conduct()
             if due["couple"]:
                 for effect in self.effect_list:
                     effect.couple()
@@ -253,6 +260,8 @@ class Coupling:
             self.track_particles(atoms)
             if self.collisions is not None:
                 self.collisions.end_of_run(atoms)
+        if self.conduction is not None:       # the run's steps since the last update
+            self.conduction.conduct()
 
     def frame_every(self) -> int:
         """DEM steps between frames: output.every, or where it is 0 the interval of the

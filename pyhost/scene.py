@@ -51,8 +51,8 @@ import tomllib
 from pathlib import Path
 
 from plugins.heat import MODELS
-from pyhost.schema import (Dem, Domain, Effects, Fluid, Material, Output, Particles, check_types,  # noqa: F401
-                           Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
+from pyhost.schema import (Conduction, Dem, Domain, Effects, Fluid, Material, Output, Particles,  # noqa: F401
+                           check_types, Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
 from pyhost.validate import check_scene
 
 
@@ -78,7 +78,7 @@ def _inlet_table(fluid, file):
         raise SceneError(f"{key}: times must increase, got {times!r}")
 
 
-SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output", "dem")
+SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output", "dem", "conduction")
 
 
 def read_text(path) -> str:
@@ -110,7 +110,7 @@ def _finite(value, key, file) -> None:
 
 def check_raw(data: dict, file: str) -> None:
     """Shapes the scene builder relies on, and finite numbers everywhere."""
-    for key in ("materials", "domain", "time", "effects", "fluid", "output"):
+    for key in ("materials", "domain", "time", "effects", "fluid", "output", "conduction"):
         if key in data and not isinstance(data[key], dict):
             raise SceneError(f"{file}: {key}: must be a table [{key}], got {data[key]!r}")
     for name, m in data.get("materials", {}).items():
@@ -237,9 +237,33 @@ def load_scene(path) -> Scene:
     if fluid is not None and fluid.inlet_table:
         _inlet_table(fluid, file)
     output = build(Output, data.get("output", {}), "output", file)
-    scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem)
+    conduction = _conduction(effects, build(Conduction, data.get("conduction", {}), "conduction", file), fluid, file)
+    scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem, conduction)
     check_scene(scene)
     return scene
+
+
+def _conduction(effects, conduction, fluid, file):
+    """The lasting conduction's settings, checked against the effects: a contact model does not
+    go with enduring_conduction (LIGGGHTS' heat/gran would conduct through the same contacts); a
+    gap model needs the gas conductivity (the scene's fluid's when not given) and Lethe's its
+    gas parameter."""
+    if effects.contact_conduction != "none" and effects.enduring_conduction:
+        raise SceneError(f"{file}: effects.contact_conduction: {effects.contact_conduction!r} and "
+                         "effects.enduring_conduction both conduct through lasting contacts (the second through "
+                         "LIGGGHTS' fix heat/gran): choose one")
+    if effects.gap_conduction == "none":
+        return conduction
+    if conduction.gas_conductivity == 0:
+        if fluid is None:
+            raise SceneError(f"{file}: conduction.gas_conductivity: missing (effects.gap_conduction = "
+                             f"{effects.gap_conduction!r} conducts through the gas, and the scene has no [fluid] to "
+                             "take it from) [W/(m K)]")
+        conduction = dataclasses.replace(conduction, gas_conductivity=fluid.conductivity)
+    if effects.gap_conduction == "lethe" and conduction.gas_parameter == 0:
+        raise SceneError(f"{file}: conduction.gas_parameter: must be > 0 with effects.gap_conduction = \"lethe\" "
+                         "(Lethe's gas parameter M [m]: without it the gas resistance of a point contact vanishes)")
+    return conduction
 
 
 def _cfdem_script(dem, data, path, file):

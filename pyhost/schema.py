@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from plugins.conduction import CONTACT, GAP
 from plugins.convection import CORRELATIONS
 from plugins.drag import LAWS as DRAG_LAWS
 from plugins.heat import MODEL_NAMES
@@ -69,6 +70,16 @@ class Effects:
                                                          "particle contacts that outlast a collision, and those "
                                                          "with walls at a temperature")
     wall_heat: bool = spec(default=True, doc="collisions with walls at a fixed temperature exchange heat")
+    contact_conduction: str = spec("in:none," + ",".join(CONTACT), "none",
+                                   "lasting conduction through particle-particle contacts, every "
+                                   "conduction.every DEM steps (plugins/conduction/contact; settings in [conduction]); a collision's "
+                                   "contact conducts only after its model duration t_coll, through its "
+                                   "collision heat before. Not with enduring_conduction or a script's fix "
+                                   "heat/gran, which conduct through the same contacts")
+    gap_conduction: str = spec("in:none," + ",".join(GAP), "none",
+                               "conduction through the gas between particles near each other or touching "
+                               "(particle-fluid-particle), every conduction.every DEM steps (plugins/conduction/gap; the gas "
+                               "conductivity and cut-offs in [conduction])")
     convection: str = spec("in:none," + ",".join(sorted(CORRELATIONS)), "none",
                            "gas-particle convection: Nusselt correlation (plugins.convection); turns on the "
                            "gas energy equation of the fluid; a CFDEM case's couplingProperties gives it when "
@@ -253,6 +264,24 @@ class Time:
 
 
 @dataclass(frozen=True)
+class Conduction:
+    every: int = spec(">0", 1, "DEM steps between two updates of lasting conduction; each update moves the "
+                               "heat of the interval exactly for an isolated pair, whatever its length "
+                               "(plugins/conduction/exchange.py), first order in it for particles with several "
+                               "neighbours; the pairs are those found at the update")
+    gas_conductivity: float = spec(">=0", 0.0, "conductivity of the gas in the gaps [W/(m K)], for "
+                                               "effects.gap_conduction; 0: fluid.conductivity of the scene's "
+                                               "[fluid] (the gas it solves), required without one")
+    lens: float = spec(">0", 0.2, "gas lens thickness around the larger particle, in its radii (MFiX's FLPC): "
+                                  "rong_horio conducts through gaps below lens * R_max [-]")
+    min_distance: float = spec(">0", 1e-6, "closest approach of two surfaces in the gas path [m] "
+                                           "(MFiX's DES_MIN_COND_DIST): rong_horio's gap is never below it")
+    gas_parameter: float = spec(">=0", 0.0, "Lethe's gas parameter M [m], added to the gap of its macrogap "
+                                            "(gap_conduction = \"lethe\"; needs > 0: a point contact's gas "
+                                            "resistance vanishes without it)")
+
+
+@dataclass(frozen=True)
 class Output:
     every: float = spec(">=0", 0.0, "interval between VTK frames and history rows [s]; 0: a script's own rhythm, "
                         "its most frequent dump at each run (frames at the steps of its dumps), else 1e-3 s "
@@ -280,6 +309,7 @@ class Scene:
     fluid: Fluid | None
     output: Output
     dem: Dem = Dem()
+    conduction: Conduction = Conduction()
 
     @property
     def folder(self) -> Path:
@@ -295,10 +325,12 @@ class Scene:
         """What the host builds for this scene."""
         heat = bool(self.effects.heat_models)
         convection = self.effects.convection != "none"
+        conduction = self.effects.contact_conduction != "none" or self.effects.gap_conduction != "none"
         return dict(
             fluid_solver=self.effects.fluid,
             convection=convection,
-            particle_temperatures=heat or convection,
+            conduction=conduction,
+            particle_temperatures=heat or convection or conduction,
             contact_extraction=heat or self.effects.restitution_feedback,
             collision_heat=heat,
             restitution_feedback=self.effects.restitution_feedback,

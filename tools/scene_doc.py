@@ -32,6 +32,9 @@ SECTIONS = (
     ("[domain]", S.Domain, "Box scenes: the box."),
     ("[time]", S.Time, "Time steps, fluid coupling and harvests."),
     ("[fluid]", S.Fluid, "The gas, solved by collheatFoam."),
+    ("[conduction]", S.Conduction, "Lasting conduction between particles (effects.contact_conduction, "
+                                   "effects.gap_conduction: plugins/conduction): how often it is updated, the gas "
+                                   "in the gaps and the gap models' cut-offs. Used only when a model is asked for."),
     ("[output]", S.Output, "What a run writes."),
 )
 

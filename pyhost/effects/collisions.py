@@ -125,11 +125,12 @@ class CollisionHeat(Effect):
     def wants_harvest(self, due: dict) -> bool:
         """Whether this chunk's end needs the events taken now: a harvest, a frame or a
         checkpoint is due, or a fluid exchange that reads the temperatures (convection) or
-        comes while a fix heat/gran conducts. A fluid exchange without either changes no
-        temperature and reads none: the events wait for the next of the others, in larger
-        batches (the heat moved is the same, collision after collision in their order)."""
+        comes while a fix heat/gran conducts, or a lasting conduction update (which must know
+        every collision begun, to leave each its t_coll). A fluid exchange without either
+        changes no temperature and reads none: the events wait for the next of the others, in
+        larger batches (the heat moved is the same, collision after collision in their order)."""
         convects = self.loop.fluid_exchange is not None and self.loop.fluid_exchange.convection
-        return any(due[k] for k in ("harvest", "frame", "checkpoint")) or (
+        return any(due[k] for k in ("harvest", "frame", "checkpoint", "conduct")) or (
             due["couple"] and (convects or bool(self.dem.events.window)))
 
     def end_of_run(self, atoms) -> None:
@@ -290,6 +291,8 @@ class CollisionHeat(Effect):
         order = np.lexsort((j, cols["i"], j >= WALL_BASE, step))
         cols = {k: v[order] for k, v in cols.items()}
         self.record(cols)
+        if self.loop.conduction is not None:
+            self.loop.conduction.collided(cols)
         if self.restitution:
             self.ask_restitution(atoms, np.concatenate([b[3] for b in batches])[order], cols["e"], ends)
 

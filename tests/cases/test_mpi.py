@@ -494,3 +494,23 @@ def test_error_inside_a_collective_call_ends_every_rank(tmp_path):
                        capture_output=True, text=True, env=ENV, timeout=300)
     assert r.returncode == 1
     assert "injected fault inside a collective call" in r.stderr
+
+
+def test_lasting_conduction_between_two_ranks_is_the_serial_one(tmp_path):
+    """cases/two-sphere-conduction's smoke run (50 s) on two ranks, its script's grid set to cut
+    the box at x = 5 mm, between the two held spheres: the temperatures of every history row equal the serial
+    run's to 1e-12 K (the host gathers the pair on rank 0 and writes Temp back to each owner)."""
+    case = tmp_path / "case"
+    shutil.copytree(CASES / "two-sphere-conduction", case, ignore=shutil.ignore_patterns("output", "log.*"))
+    script = case / "in.liggghts"
+    script.write_text(script.read_text().replace("units si\n", "units si\nprocessors 2 1 1\n"))
+    serial = run(case, tmp_path / "serial", 1, "--test")
+    parallel = run(case, tmp_path / "two", 2, "--test")
+    assert grid(tmp_path / "two") == "2 by 1 by 1"
+    rows = [list(csv.DictReader(open(tmp_path / name / "history.csv"))) for name in ("serial", "two")]
+    assert len(rows[0]) == len(rows[1]) == 51
+    for a, b in zip(*rows):
+        assert abs(float(a["T_group0"]) - float(b["T_group0"])) < 1e-12
+        assert abs(float(a["T_group1"]) - float(b["T_group1"])) < 1e-12
+    assert parallel["heat_conducted_contact"] == pytest.approx(serial["heat_conducted_contact"], rel=1e-12)
+    assert abs(parallel["energy_balance_error"]) < 1e-12

@@ -4,6 +4,7 @@ import sys
 
 import pytest
 
+from plugins.conduction import CONTACT, GAP
 from plugins.convection import CORRELATIONS
 from plugins.drag import LAWS
 from plugins.heat import MODEL_NAMES, MODELS
@@ -35,6 +36,7 @@ def test_a_new_file_is_a_new_entry_and_helpers_are_not(tmp_path, monkeypatch):
 
 def test_every_kind_of_model_uses_the_one_registry():
     for registry, some in ((MODELS, {"A", "B", "C"}), (COMPARISON, {"hertz", "softened", "zhou"}),
-                           (LAWS, {"gidaspow", "ergun", "wenyu"}), (CORRELATIONS, {"gunn", "ranz_marshall"})):
+                           (LAWS, {"gidaspow", "ergun", "wenyu"}), (CORRELATIONS, {"gunn", "ranz_marshall"}),
+                           (CONTACT, {"mfix", "morris", "lethe"}), (GAP, {"rong_horio", "lethe"})):
         assert isinstance(registry, Registry) and some <= set(registry)
     assert MODEL_NAMES == tuple(MODELS) + tuple(COMPARISON)

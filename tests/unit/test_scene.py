@@ -49,7 +49,7 @@ def test_valid_scene_loads_with_defaults(tmp_path):
     assert s.materials["steel"].dem.friction == 0.3             # default
     assert s.time.sample_every == 1 and s.fluid is None
     effects = s.effects_summary()
-    assert effects == dict(fluid_solver=False, convection=False, particle_temperatures=True,
+    assert effects == dict(fluid_solver=False, convection=False, conduction=False, particle_temperatures=True,
                            contact_extraction=True, collision_heat=True,
                            restitution_feedback=False, enduring_conduction=False, wall_heat=True)
 
@@ -84,6 +84,19 @@ def test_dry_isothermal_scene_builds_nothing_extra(tmp_path):
     ("[domain]", "[fluid]\nconductivity = 0.0\n\n[domain]", "fluid.conductivity: must be > 0"),
     ("[domain]", "[fluid]\nheat_capacity = -5.0\n\n[domain]", "fluid.heat_capacity: must be > 0"),
     ("dem_step = 1e-6", "dem_step = nan", "time.dem_step: must be finite"),
+    ('contact_heat = "A"', 'contact_heat = "A"\ncontact_conduction = "zhou"',
+     "effects.contact_conduction: must be one of none, lethe, mfix, morris, got 'zhou'"),
+    ('contact_heat = "A"', 'contact_heat = "A"\ngap_conduction = "bob"',
+     "effects.gap_conduction: must be one of none, lethe, rong_horio, got 'bob'"),
+    ('contact_heat = "A"', 'contact_heat = "A"\ncontact_conduction = "mfix"\nenduring_conduction = true',
+     "effects.contact_conduction: 'mfix' and effects.enduring_conduction both conduct"),
+    ('contact_heat = "A"', 'contact_heat = "A"\ngap_conduction = "rong_horio"',
+     "conduction.gas_conductivity: missing (effects.gap_conduction = 'rong_horio'"),
+    ('contact_heat = "A"', 'contact_heat = "A"\ngap_conduction = "lethe"\n[conduction]\ngas_conductivity = 0.026',
+     "conduction.gas_parameter: must be > 0 with effects.gap_conduction"),
+    ("[domain]", "[conduction]\nlens = 0.0\n\n[domain]", "conduction.lens: must be > 0"),
+    ("[domain]", "[conduction]\nevery = 0\n\n[domain]", "conduction.every: must be > 0"),
+    ("[domain]", "[conduction]\nreach = 1.0\n\n[domain]", "conduction.reach: unknown key; known: every"),
 ])
 def test_mistakes_name_file_and_key(tmp_path, old, new, message):
     assert old in VALID
@@ -162,3 +175,25 @@ def test_a_missing_scene_file_says_what_the_folder_is(tmp_path, files, where, wo
     message = str(err.value)
     assert message.startswith(f"{tmp_path / where / 'case.toml'}: no such scene file")
     assert all(w in message for w in words) and (words or message.endswith("no such scene file")), message
+
+
+def test_conduction_is_built_only_when_asked_and_takes_the_fluid_gas(tmp_path):
+    """A scene without a conduction model builds none (and neither needs nor reads [conduction]);
+    a gap model takes the [fluid]'s gas conductivity when [conduction] gives none."""
+    plain = load_scene(write(tmp_path, VALID))
+    assert not plain.effects_summary()["conduction"]
+    gas = load_scene(write(tmp_path, VALID.replace('contact_heat = "A"', 'contact_heat = "none"\ngap_conduction = '
+                                                   '"rong_horio"').replace("[domain]", "[fluid]\nconductivity = 0.03"
+                                                                           "\n\n[domain]")))
+    assert gas.effects_summary()["conduction"] and gas.effects_summary()["particle_temperatures"]
+    assert gas.conduction.gas_conductivity == 0.03
+
+
+def test_a_conduction_mistake_stops_the_run_with_exit_2(tmp_path):
+    import subprocess
+    import sys
+    path = write(tmp_path, VALID.replace('contact_heat = "A"', 'contact_heat = "A"\ncontact_conduction = "zhou"'))
+    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True)
+    assert r.returncode == 2
+    assert str(path) in r.stderr and "effects.contact_conduction: must be one of none, lethe, mfix, morris" in r.stderr
