@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 from test_script_checks import HEAD, run, toml
-from test_script_time import dump_steps
+from test_script_time import dump_steps, restarts_bit_for_bit
 
 pytestmark = pytest.mark.engines
 ROOT = Path(__file__).resolve().parents[2]
@@ -70,25 +70,10 @@ def test_a_restart_inside_a_loop_goes_on_where_the_loop_stood(tmp_path):
     replays what the script ran (the 'next's included, so the variable is where it was), ends
     the interrupted run and goes on through the loop; collisions.csv, history.csv and
     summary.json equal the uninterrupted run's to the bit."""
-    from conftest import STOPPER
-
-    script = BOX + FLOWS["if_jump_out"][0]
-    case_toml = toml().replace("[output]\n", "[output]\ncheckpoint = 0.001\n")
-    r, whole = run(tmp_path, script, case_toml)
-    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-    assert whole["steps"] == 350
-    cut = tmp_path / "cut"
-    stopped = subprocess.run([sys.executable, "-c", STOPPER, "250", "SIGTERM", "run", str(tmp_path), "--out",
-                              str(cut)], capture_output=True, text=True, cwd=ROOT, timeout=600)
-    assert stopped.returncode == 128 + 15, stopped.stdout[-3000:] + stopped.stderr[-3000:]
-    assert "checkpoint at t = 0.0025 s (step 250)" in stopped.stdout
-    again = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(cut), "--restart"],
-                           capture_output=True, text=True, cwd=ROOT, timeout=600)
-    assert again.returncode == 0, again.stdout[-3000:] + again.stderr[-3000:]
-    assert "restarted in this run, 50 steps to go" in again.stdout
-    for name in ("collisions.csv", "history.csv"):
-        assert (cut / name).read_bytes() == (tmp_path / "out" / name).read_bytes(), name
-    assert json.loads((cut / "summary.json").read_text()) == whole
+    whole, said = restarts_bit_for_bit(tmp_path, BOX + FLOWS["if_jump_out"][0],
+                                       toml().replace("[output]\n", "[output]\ncheckpoint = 0.001\n"), 250,
+                                       "checkpoint at t = 0.0025 s (step 250)")
+    assert whole["steps"] == 350 and "restarted in this run, 50 steps to go" in said
 
 
 @pytest.mark.parametrize("flow", ["loop", "if_runs"])

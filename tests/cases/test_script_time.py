@@ -82,27 +82,35 @@ def test_time_is_summed_across_timestep_changes_and_resets(tmp_path):
     assert sum(t > 0.02 for t in times) > 0          # collisions in the run after the reset too
 
 
-def test_a_restart_across_a_time_step_change_continues_the_clock(tmp_path):
-    """The same script with a checkpoint every 2.5 ms, stopped by SIGTERM in its second run (at
-    the smaller time step) and restarted: it goes through the reset_timestep and its third run,
-    and collisions.csv, history.csv and summary.json equal the uninterrupted run's to the bit."""
+def restarts_bit_for_bit(tmp_path: Path, script: str, case_toml: str, stop_at: int, said: str) -> tuple[dict, str]:
+    """The script run whole, then again stopped by SIGTERM at step ``stop_at`` (its checkpoint
+    there ``said``) and restarted: collisions.csv, history.csv and summary.json equal to the
+    bit. Returns the summary and what the restart printed."""
     from conftest import STOPPER
 
-    case_toml = toml().replace("[output]\n", "[output]\ncheckpoint = 0.0025\n")
-    r, whole = run(tmp_path, SCRIPT, case_toml)
+    r, whole = run(tmp_path, script, case_toml)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-    assert whole["time"] == pytest.approx(TIME, rel=1e-12, abs=0)
     cut = tmp_path / "cut"
-    stopped = subprocess.run([sys.executable, "-c", STOPPER, "2000", "SIGTERM", "run", str(tmp_path), "--out",
+    stopped = subprocess.run([sys.executable, "-c", STOPPER, str(stop_at), "SIGTERM", "run", str(tmp_path), "--out",
                               str(cut)], capture_output=True, text=True, cwd=ROOT, timeout=600)
     assert stopped.returncode == 128 + 15, stopped.stdout[-3000:] + stopped.stderr[-3000:]
-    assert "checkpoint at t = 0.015 s (step 2000)" in stopped.stdout
+    assert said in stopped.stdout
     again = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(cut), "--restart"],
                            capture_output=True, text=True, cwd=ROOT, timeout=600)
     assert again.returncode == 0, again.stdout[-3000:] + again.stderr[-3000:]
     for name in ("collisions.csv", "history.csv"):
         assert (cut / name).read_bytes() == (tmp_path / "out" / name).read_bytes(), name
     assert json.loads((cut / "summary.json").read_text()) == whole
+    return whole, again.stdout
+
+
+def test_a_restart_across_a_time_step_change_continues_the_clock(tmp_path):
+    """The same script with a checkpoint every 2.5 ms, stopped by SIGTERM in its second run (at
+    the smaller time step) and restarted: it goes through the reset_timestep and its third run,
+    and collisions.csv, history.csv and summary.json equal the uninterrupted run's to the bit."""
+    whole, _ = restarts_bit_for_bit(tmp_path, SCRIPT, toml().replace("[output]\n", "[output]\ncheckpoint = 0.0025\n"),
+                                    2000, "checkpoint at t = 0.015 s (step 2000)")
+    assert whole["time"] == pytest.approx(TIME, rel=1e-12, abs=0)
 
 
 def collision(row) -> tuple:
