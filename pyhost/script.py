@@ -118,25 +118,33 @@ def read_script(path: str | Path, folder: str | Path | None = None, temperatures
     commands = script_commands(path, folder)
     _check_host_ids(commands, temperatures)
     for cmd in commands:
-        if cmd.name == "jump":
-            _check_jump(cmd, Path(folder) if folder is not None else Path(path).parent)
-        if cmd.name == "if":
-            _check_if(cmd)
-        if cmd.name == "shell":
-            _check_shell(cmd)
-        if cmd.name == "delete_atoms":
-            _check_delete(cmd)
-        if cmd.name == "units" and cmd.text.split()[1:] != ["si"]:
-            raise ScriptError(f"{cmd.where()}: '{cmd.text}': the host's contact models, heat and energy balance "
-                              "are in SI; give 'units si' (and the script's values in SI)")
-        style = cmd.text.split()[3] if cmd.name == "fix" and len(cmd.text.split()) > 3 else ""
-        if style.split("/")[-1] == "multisphere":
-            raise ScriptError(f"{cmd.where()}: fix {style}: rigid clumps of spheres (multisphere) are not "
-                              "supported: the collision heat models and the energy balance take each atom for a "
-                              "sphere of its own mass, and a clump's spheres carry the whole clump's")
-        if cmd.name == "run":
-            parse_run(cmd)              # its forms the host cannot run refused before any engine time
+        _check(cmd, Path(folder) if folder is not None else Path(path).parent)
     return commands
+
+
+def _check(cmd: Command, folder: Path) -> None:
+    """One command of the script (or of an ``if``'s branch, checked as the script's own):
+    ScriptError naming its line for what the host cannot run."""
+    if cmd.name == "jump":
+        _check_jump(cmd, folder)
+    if cmd.name == "if":
+        for branch in if_branches(cmd)[1]:
+            for text in branch:
+                _check(Command(text, cmd.file, cmd.line), folder)
+    if cmd.name == "shell":
+        _check_shell(cmd)
+    if cmd.name == "delete_atoms":
+        _check_delete(cmd)
+    if cmd.name == "units" and cmd.text.split()[1:] != ["si"]:
+        raise ScriptError(f"{cmd.where()}: '{cmd.text}': the host's contact models, heat and energy balance "
+                          "are in SI; give 'units si' (and the script's values in SI)")
+    style = cmd.text.split()[3] if cmd.name == "fix" and len(cmd.text.split()) > 3 else ""
+    if style.split("/")[-1] == "multisphere":
+        raise ScriptError(f"{cmd.where()}: fix {style}: rigid clumps of spheres (multisphere) are not "
+                          "supported: the collision heat models and the energy balance take each atom for a "
+                          "sphere of its own mass, and a clump's spheres carry the whole clump's")
+    if cmd.name == "run":
+        parse_run(cmd)              # its forms the host cannot run refused before any engine time
 
 
 def host_fix_refusal(line: str) -> str | None:
@@ -238,20 +246,6 @@ def _check_jump(cmd: Command, folder: Path) -> None:
                           "supported (the host follows the script's jumps itself): write the name")
     if words[1] != "SELF" and not (folder / words[1]).is_file():
         raise ScriptError(f"{cmd.where()}: '{cmd.text}': no script {folder / words[1]}")
-
-
-def _check_if(cmd: Command) -> None:
-    """The commands inside ``if ... then "..." [elif ... "..."] [else "..."]`` run as the
-    script's own (``Program``), so each is checked as they are."""
-    for branch in if_branches(cmd)[1]:
-        for text in branch:
-            inner = Command(text, cmd.file, cmd.line)
-            if inner.name == "if":
-                _check_if(inner)
-            elif inner.name == "shell":
-                _check_shell(inner)
-            elif inner.name == "run":
-                parse_run(inner)
 
 
 def if_branches(cmd: Command) -> tuple[list[str], list[list[str]]]:
