@@ -21,6 +21,7 @@ import fcntl
 import functools
 import math
 import os
+import re
 import select
 import shutil
 import signal
@@ -116,6 +117,32 @@ def run_utility(case: Path, *command: str) -> None:
     if rc != 0:
         raise FluidError(f"{command[0]} failed in {case} (exit code {rc}); end of {log}:\n"
                          f"{log_tail(log)}")
+
+
+SEVERE_NON_ORTHOGONALITY = 70.0
+"""deg: OpenFOAM's own threshold of a severely non-orthogonal face (checkMesh)."""
+
+
+def non_orthogonal_cause(case: Path) -> str:
+    """Words naming the mesh's non-orthogonality as a likely cause of a diverged run, when
+    checkMesh finds faces beyond SEVERE_NON_ORTHOGONALITY, with the case's non-orthogonal
+    correctors; '' otherwise (or if checkMesh cannot tell)."""
+    try:
+        r = subprocess.run(["checkMesh", "-case", str(case), "-constant", "-noTopology"], capture_output=True,
+                           text=True, errors="replace", env=foam_env(), timeout=300)
+    except (OSError, subprocess.TimeoutExpired):
+        return ""
+    found = re.search(r"Mesh non-orthogonality Max: ([\d.eE+-]+)", r.stdout)
+    if not found or float(found.group(1)) <= SEVERE_NON_ORTHOGONALITY:
+        return ""
+    faces = re.search(r"Number of severely non-orthogonal \(> [\d.]+ degrees\) faces: (\d+)", r.stdout)
+    correctors = re.search(r"nNonOrthogonalCorrectors\s+(\d+)", (case / "system" / "fvSolution").read_text(
+        errors="replace")) if (case / "system" / "fvSolution").is_file() else None
+    return (f"; the mesh is strongly non-orthogonal, up to {float(found.group(1)):.1f} deg (checkMesh"
+            + (f": {faces.group(1)} faces above {SEVERE_NON_ORTHOGONALITY:g} deg" if faces else "")
+            + f"), with {correctors.group(1) if correctors else 0} non-orthogonal correctors (fvSolution's PIMPLE "
+            "nNonOrthogonalCorrectors): a likely cause; give it 2 or more and laplacianSchemes 'Gauss linear "
+            "limited corrected 0.5', or mesh the case with less skewed cells")
 
 
 class FluidSolver:
@@ -551,8 +578,10 @@ class FluidSolver:
             how = f"killed by {signal.Signals(-rc).name}"
             if -rc == signal.SIGFPE:
                 how += ": a floating point exception, the run diverged"
-        return FluidError(f"the fluid solver stopped while {what} ({how}); "
-                          f"end of {self.log}:\n{log_tail(self.log)}")
+        tail = log_tail(self.log)
+        if rc == -signal.SIGFPE or "the fluid diverged" in tail:    # (collheatFoam's maxSpeed guard says so)
+            how += non_orthogonal_cause(self.case)
+        return FluidError(f"the fluid solver stopped while {what} ({how}); end of {self.log}:\n{tail}")
 
     def _open_writer(self, path: Path) -> int:
         """The host's end of a request pipe, non-blocking: writes wait in :meth:`_send`."""

@@ -253,6 +253,30 @@ def test_diverging_run_raises_with_the_solver_message(tmp_path):
         assert fluid.advance(5e-3) == pytest.approx(5e-3)
 
 
+@pytest.mark.parametrize("shear", [0.0, 0.04])
+def test_a_diverged_run_on_a_strongly_non_orthogonal_mesh_names_it(tmp_path, shear):
+    """The same blow-up on the box whose top face is shifted 40 mm over its 10 mm height
+    (non-orthogonality 76 deg everywhere, checkMesh): the message names the mesh's
+    non-orthogonality and the case's non-orthogonal correctors (0) as a likely cause; on the
+    straight box it does not."""
+    case = box_case(tmp_path / "bad", lo=(0, 0, 0), hi=(0.01, 0.001, 0.01), cells=(10, 1, 10),
+                    dt=1.0, max_speed=100.0, n_correctors=1,
+                    boundaries={"xlo": ("inlet", (50, 0, 0)), "xhi": "outlet", "ylo": "slip",
+                                "yhi": "slip", "zlo": "wall", "zhi": "wall"}, **WATER)
+    mesh = case / "system" / "blockMeshDict"
+    top = "(0.0 0.0 0.01) (0.01 0.0 0.01) (0.01 0.001 0.01) (0.0 0.001 0.01)"
+    assert top in mesh.read_text()
+    mesh.write_text(mesh.read_text().replace(top, f"({shear} 0.0 0.01) ({shear + 0.01} 0.0 0.01) "
+                                                  f"({shear + 0.01} 0.001 0.01) ({shear} 0.001 0.01)"))
+    with pytest.raises(FluidError, match="diverged") as err:
+        with FluidSolver(case) as fluid:
+            for _ in range(50):
+                fluid.advance(1.0)
+    named = "the mesh is strongly non-orthogonal, up to 76.0 deg (checkMesh: 180 faces above 70 deg), with 0 " \
+            "non-orthogonal correctors" in str(err.value)
+    assert named == (shear > 0), str(err.value)[:600]
+
+
 def test_an_advance_left_to_run_gives_the_same_fluid_and_waits_at_the_next_use(tmp_path):
     """lid_box with 200 moving particles, 10 couplings: each advance sent with wait=False (the
     host free while the solver steps, as beside the DEM's chunk) against waiting for each. The
