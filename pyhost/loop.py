@@ -345,7 +345,8 @@ class Coupling:
                     raise
                 print(f"warning: {type(err).__name__} at the end of a run that stopped: {err}")
         self.progress.update(self.t, f", {self.totals['collisions']} collisions", force=True)
-        self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
+        if self.totals["heat_by_model"] is None:      # (a scene without collisions: each model's 0 J)
+            self.totals["heat_by_model"] = dict.fromkeys(self.scene.effects.heat_models, 0.0)
         summary = dict(self.totals, status=status, time=self.t, steps=self.steps, step=self.dem.step, groups=self.frames.group_names)
         for effect in self.effect_list:
             effect.finish(summary, status)

@@ -61,7 +61,9 @@ class CollisionHeat(Effect):
 
     TOTALS = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0, heat_from_walls=0.0,
                   capped=0, clipped=0, heat_gran_undone=0.0, heat_gran_walls_undone=0.0,
-                  outside_model_range=0)
+                  outside_model_range=0, contacts_without_impact=0, collisions_of_departed=0,
+                  collisions_moved_on_ranks=0, contacts_changed_rank=0, restitution_late=0,
+                  restitution_not_imposed=0, heat_gran_undo_cut=0, heat_by_model=None)
 
     def __init__(self, loop, walls, logs: dict | None = None):
         super().__init__(loop)
@@ -219,7 +221,7 @@ class CollisionHeat(Effect):
                 balance.track(dataclasses.replace(before, T=p["T_after"]), departures=False)
             self.totals["capped"] += p["capped"]
             if p["still"]:
-                self.totals["contacts_without_impact"] = self.totals.get("contacts_without_impact", 0) + p["still"]
+                self.totals["contacts_without_impact"] += p["still"]
             if p["flagged"]:
                 self.flag_outside_range(p["flagged"], p["v_flagged"])
         moved = [(p["cols"], p["step"], p["jj"], p.get("begun")) for p in parts]
@@ -234,7 +236,7 @@ class CollisionHeat(Effect):
             loop.track_particles(atoms, departures=False)
         count = sum(len(p["step"]) for p in parts)
         if count:
-            self.totals["collisions_moved_on_ranks"] = self.totals.get("collisions_moved_on_ranks", 0) + count
+            self.totals["collisions_moved_on_ranks"] += count
         self.harvest(atoms, ev=ev, moved=moved)
 
     def restitution_atoms(self, begun, ends) -> list:
@@ -267,7 +269,7 @@ class CollisionHeat(Effect):
         ev = self.dem.events.take() if ev is None else ev
         begin, ends = ev[ev["kind"] == BEGIN], ev[ev["kind"] == END]
         if self.dem.events.joined:               # open contacts that moved between ranks (MPI)
-            self.totals["contacts_changed_rank"] = self.totals.get("contacts_changed_rank", 0) + len(self.dem.events.joined)
+            self.totals["contacts_changed_rank"] += len(self.dem.events.joined)
         if self.targets and len(ends):
             self.ended_with_targets(atoms, ends)
         batches = list(moved) + (self.collide_begun(atoms, begin) if len(begin) else [])
@@ -314,8 +316,8 @@ class CollisionHeat(Effect):
         if late:
             rows = np.array([r for r, _, _ in late])
             present = (atoms.index(ends["i"][rows]) >= 0) & (ends["wall"][rows] | (atoms.index(ends["j"][rows]) >= 0))
-            self.totals["restitution_not_imposed"] = self.totals.get("restitution_not_imposed", 0) + int((~present).sum())
-            self.totals["restitution_late"] = self.totals.get("restitution_late", 0) + int(present.sum())
+            self.totals["restitution_not_imposed"] += int((~present).sum())
+            self.totals["restitution_late"] += int(present.sum())
             self.impose_separation(atoms, ends["i"][rows], ends["j"][rows], np.array([n for _, _, n in late]),
                                    np.ones(len(rows)), np.array([v for _, v, _ in late]))
 
@@ -326,12 +328,12 @@ class CollisionHeat(Effect):
         j_here = np.where(begin["wall"], 0, atoms.index(np.where(begin["wall"], begin["i"], begin["j"])))
         here = (i >= 0) & (j_here >= 0)
         if not here.all():
-            self.totals["collisions_of_departed"] = self.totals.get("collisions_of_departed", 0) + int((~here).sum())
+            self.totals["collisions_of_departed"] += int((~here).sum())
         # a contact that begins without closing in (particles grown into each other by a fix
         # adapt, or placed touching) is no impact: open, with no collision heat
         still = here & ~(begin["vn"] > 0)
         if still.any():
-            self.totals["contacts_without_impact"] = self.totals.get("contacts_without_impact", 0) + int(still.sum())
+            self.totals["contacts_without_impact"] += int(still.sum())
         begin = begin[here & ~still]
         # in the order of step, then ids: not of the recorder's lists, which follow the atoms'
         # order in memory (a restart or another number of ranks changes it)
@@ -361,7 +363,7 @@ class CollisionHeat(Effect):
             self.dem.events.restitution(keys[ask], speed[ask], begin["n"][ask])
             self.targets.update(zip(keys[ask].tolist(), zip(speed[ask].tolist(), begin["n"][ask].tolist())))
         if late.any():
-            self.totals["restitution_late"] = self.totals.get("restitution_late", 0) + int(late.sum())
+            self.totals["restitution_late"] += int(late.sum())
             self.impose_separation(atoms, begin["i"][late], begin["j"][late], begin["n"][late],
                                    np.minimum(e[late], 1.0), v0[late])
 
@@ -385,7 +387,7 @@ class CollisionHeat(Effect):
         steps = t_coll / dt
         cut = np.isfinite(steps) & (steps > window) & (filled == window)
         if cut.any():
-            self.totals["heat_gran_undo_cut"] = self.totals.get("heat_gran_undo_cut", 0) + int(cut.sum())
+            self.totals["heat_gran_undo_cut"] += int(cut.sum())
         share = np.clip(np.nan_to_num(steps)[:, None] - np.arange(window), 0.0, 1.0)
         share[np.arange(window) >= filled[:, None]] = 0.0
         q = dt * np.sum(flux * share, axis=1)              # heat heat/gran moved into i [J]
@@ -449,7 +451,9 @@ class CollisionHeat(Effect):
     def heat_by_model(self) -> dict:
         """Heat between particles [J], sum of |Q| over collisions, of each heat model: the one
         that moved it and the side models on the same collisions."""
-        return self.totals.setdefault("heat_by_model", dict.fromkeys(self.scene.effects.heat_models, 0.0))
+        if self.totals["heat_by_model"] is None:
+            self.totals["heat_by_model"] = dict.fromkeys(self.scene.effects.heat_models, 0.0)
+        return self.totals["heat_by_model"]
 
     def impose_separation(self, atoms, ids_i, ids_j, normal, e, v0) -> int:
         """The model's separation speed e v0 [m/s] imposed now on each pair's normal velocity

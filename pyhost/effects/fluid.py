@@ -52,9 +52,10 @@ def layer_pressure_drop(fluid, up) -> float:
     last digits (NaN for a mesh one cell high)."""
     p, _ = fluid.fields()
     h = fluid.cell_centres @ up
-    tol = 1e-6 * (h.max() - h.min())
-    if not tol > 0:
+    span = h.max() - h.min()
+    if not span > 1e-9 * np.abs(h).max():     # one layer along up: heights apart in their last digits only
         return math.nan
+    tol = 1e-6 * span
     return float(p[h < h.min() + tol].mean() - p[h > h.max() - tol].mean())
 
 

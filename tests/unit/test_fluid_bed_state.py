@@ -51,3 +51,17 @@ def test_bed_figures_are_taken_against_gravity(axis, sign):
 def test_upwards_is_against_gravity_and_z_without_it():
     assert upwards(SimpleNamespace(gravity=lambda: np.array([0.0, -9.81, 0.0]))).tolist() == [0.0, 1.0, 0.0]
     assert upwards(SimpleNamespace(gravity=lambda: np.zeros(3))).tolist() == [0.0, 0.0, 1.0]
+
+
+def test_a_mesh_one_cell_high_along_gravity_has_no_pressure_drop():
+    """Cell centres of one layer whose heights differ in their last digits (no gravity: +z;
+    a column one cell high): NaN, not a mean of an empty layer with numpy's warnings."""
+    import warnings
+
+    from pyhost.effects.fluid import layer_pressure_drop
+
+    centres = np.column_stack([np.linspace(0, 1, 30), np.zeros(30), 0.05 + np.arange(30) * 1e-18])
+    fluid = SimpleNamespace(cell_centres=centres, fields=lambda: (np.arange(30.0), None))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.isnan(layer_pressure_drop(fluid, np.array([0.0, 0.0, 1.0])))

@@ -2,6 +2,7 @@
 pyhost/ nothing of tools/ (scripts that import pyhost), and no module of either reaches
 itself again through its imports, counting those inside functions."""
 import ast
+import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -136,7 +137,9 @@ def test_the_plugins_python_is_pure_but_for_the_table_cache():
 def test_each_total_is_declared_once_by_the_effect_that_adds_to_it():
     """summary.json's totals: each effect's ``TOTALS`` (no key in two effects: they would add
     to one number without knowing), all of them in ``pyhost.loop.totals()``, and every total an
-    effect adds to with ``+=`` declared (else the run's first such addition is a KeyError)."""
+    effect adds to with ``+=`` declared (else the run's first such addition is a KeyError), and
+    none added to without a declaration (``totals.get(k, 0) + n``: a key a summary has only
+    when it is not 0)."""
     import importlib
 
     from pyhost.effects import Effect
@@ -158,3 +161,8 @@ def test_each_total_is_declared_once_by_the_effect_that_adds_to_it():
                 added.add((f.name, node.target.slice.value))
     assert len(added) >= 15                     # (the scan finds the effects' additions)
     assert not {k for _, k in added} - set(declared), sorted(added)
+    # and none added around the declaration (totals.get(k, 0) + n, setdefault): anywhere in pyhost
+    around = [f"{f.relative_to(ROOT)}:{n}" for f in (ROOT / "pyhost").rglob("*.py")
+              for n, line in enumerate(f.read_text().splitlines(), 1)
+              if re.search(r"totals\.get\(|totals\.setdefault\(", line)]
+    assert around == [], around
