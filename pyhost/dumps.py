@@ -307,6 +307,35 @@ def _is_number(words: list[str]) -> bool:
         return False
 
 
+def check_given_numbers(commands, setup, where_of, given: dict) -> None:
+    """A ``--var NAME VALUE`` whose value is not a number, where a command post reads as numbers
+    (a timestep, run, property/global, primitive wall, Temp set) takes it, directly or through
+    the script's variables: ValueError naming the variable, its value and the command's line.
+    (LIGGGHTS would put the word in the command; post could not read the value and used the
+    scene's instead, with exit 0.)"""
+    bad = {name: value for name, value in given.items() if not _is_number([value])}
+    if not bad:
+        return
+    needs = {}                          # a set-up variable -> the variables its definition names
+    for _, text in setup:
+        words = text.split()
+        if words[0] == "variable" and len(words) > 3:
+            needs.setdefault(words[1], set()).update(_references(" ".join(words[3:])))
+    for number, line in commands:
+        if "$" not in line or not _read_by_post(line.split()):
+            continue
+        seen, todo = set(), list(_references(line))
+        while todo:                     # the variables it names, and those they name in turn
+            name = todo.pop()
+            if name not in seen:
+                seen.add(name)
+                todo.extend(needs.get(name, ()) if name not in given else ())
+        name = next((n for n in sorted(seen) if n in bad), None)
+        if name is not None:
+            raise ValueError(f"--var {name} {bad[name]!r}: not a number, and {where_of[number]} takes it as one "
+                             f"('{line}')")
+
+
 def read_script(path, variables: dict | None = None) -> Script:
     """Reads ``timestep``, the local computes and the mesh wall fixes of a LIGGGHTS input, its
     property/globals, wall types, and the steps at which it sets particles' Temp (counted
@@ -324,6 +353,7 @@ def read_script(path, variables: dict | None = None) -> Script:
     variables = {str(k): str(v) for k, v in (variables or {}).items()}
     setup = [(number, line) for number, line in commands if line.split()[0] in SETUP_COMMANDS]
     same, why_not = setup_variables(setup, variables)
+    check_given_numbers(commands, setup, where_of, variables)
     warnings, asked = [], []
     for number, line in commands:
         if "$" not in line or not _read_by_post(line.split()):

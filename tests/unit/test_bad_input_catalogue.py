@@ -516,3 +516,32 @@ def test_debug_shows_the_error_itself(where, tmp_path):
     args = ["run", str(tmp_path / "missing")]
     with pytest.raises(SceneError, match="no such scene file"):
         main(["--debug", *args] if where == "before" else [*args, "--debug"])
+
+
+POST_SCENE = """[materials.glass]
+types = [1]
+density = 2500.0
+youngs_modulus = 63e9
+poisson_ratio = 0.22
+yield_stress = 500e6
+heat_capacity = 800.0
+conductivity = 1.0
+dem = { youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }
+"""
+
+
+@pytest.mark.parametrize("script,line", [("fix m1 all property/global youngsModulus peratomtype ${E}\n", 2),
+                                         ("variable E2 equal 2*${E}\nfix m1 all property/global youngsModulus "
+                                          "peratomtype ${E2}\n", 3)],
+                         ids=["used directly", "through a variable"])
+def test_post_var_not_a_number(script, line, tmp_path, capsys):
+    """``post --var E abc``, where the script's property/global takes ${E}: LIGGGHTS would put
+    the word in the command and post used the scene's modulus with exit 0; refused before any
+    dump is read, naming the variable, its value and the script's line."""
+    (tmp_path / "in.s").write_text("units si\n" + script + "timestep 1e-5\n")
+    (tmp_path / "scene.toml").write_text(POST_SCENE)
+    code, err = run_main(["post", tmp_path / "dump.*", "--scene", tmp_path / "scene.toml", "--script",
+                          tmp_path / "in.s", "--var", "E", "abc", "--out", tmp_path / "out"], capsys)
+    assert code == 2, err
+    assert_one_line(err, ["--var E 'abc'", "not a number", f"in.s: line {line}", "youngsModulus"])
+    assert not (tmp_path / "out").exists()
