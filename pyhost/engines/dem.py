@@ -116,12 +116,34 @@ class Dem:
 
     def command(self, cmd: Command) -> None:
         """Run one script command; a refusal names the script's file and line."""
+        self.check_temperature_set(cmd)
         try:
             self._raw(cmd.text)
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()}: {exc}{refusal_hint(cmd, str(exc))}") from None
         self.info.learn(cmd)
+        if cmd.name == "timestep" and not self.dt > 0:     # LIGGGHTS takes it; every run would then stand still
+            raise ScriptError(f"{cmd.where()}: '{cmd.text}': the time step is {self.dt:g} s: give the script a "
+                              "positive 'timestep'")
         self.report_warnings(cmd)
+
+    def check_temperature_set(self, cmd: Command) -> None:
+        """A ``set ... property/atom Temp VALUE`` at or below 0 K is refused before it runs,
+        naming the script's line (LIGGGHTS takes it; the heat models, the energy balance and
+        a particle's start, refused at 0 K, need kelvins above 0). A per-atom ``v_name`` is
+        left to the check of the particles' start."""
+        w = cmd.words
+        if not (w and w[0] == "set" and "property/atom" in w[:-2] and w[w.index("property/atom") + 1] == "Temp"):
+            return
+        word = w[w.index("property/atom") + 2]
+        if word.startswith("v_"):
+            return
+        try:
+            T = self.value(word)
+        except ScriptError:
+            return                      # LIGGGHTS' own refusal of the command names it
+        if not T > 0:
+            raise ScriptError(f"{cmd.where()}: '{cmd.text}': {T:g} K: temperatures must be above 0 K")
 
     def commands(self, cmds: list[Command]) -> None:
         """The script's commands up to its next ``run`` (none of them a run), in order. A serial

@@ -206,9 +206,41 @@ def test_run_commands_keep_liggghts_rules(tmp_path, runs, message):
 
 
 def test_a_zero_time_step_is_refused(tmp_path):
+    """Named at its own line (17), not at the first run's (26) where it was found."""
     r, _ = run(tmp_path, header().replace("timestep 1e-5", "timestep 0") + "run 100\n", toml())
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
-    assert "the time step is 0 s" in r.stderr
+    assert "in.run:17: 'timestep 0': the time step is 0 s" in r.stderr, r.stderr
+
+
+HEAT = "fix m5 all property/global thermalCapacity peratomtype 840\nfix ht all heat/gran initial_temperature 300.\n"
+
+
+@pytest.mark.parametrize("where, value", [("before", "-50"), ("between", "-50"), ("between", "0")])
+def test_a_temperature_set_at_or_below_0_K_is_refused(tmp_path, where, value):
+    """A script's 'set ... property/atom Temp -50' (or 0), before the first run or between
+    two: LIGGGHTS takes it and the run went on at -50 K with exit 0; refused at the set's own
+    line (28 or 29) with the value, as a particle starting at 0 K is."""
+    conduct = header() + "fix m6 all property/global thermalConductivity peratomtype 1.0\n" + HEAT
+    bad = f"set group all property/atom Temp {value}\n"
+    script = conduct + (bad + "run 100\n" if where == "before" else "run 100\n" + bad + "run 100\n")
+    line = script.splitlines().index(bad.strip()) + 1
+    r, s = run(tmp_path, script, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert f"in.run:{line}: '{bad.strip()}': {value} K: temperatures must be above 0 K" in r.stderr, r.stderr
+    if where == "between":              # the run before it kept: summary.json of its 100 steps
+        assert s["steps"] == 100 and s["status"].startswith("stopped at t = ")
+
+
+def test_a_fix_refused_at_the_first_run_is_named_at_its_own_line(tmp_path):
+    """A fix heat/gran without the script's thermalConductivity: LIGGGHTS takes the fix and
+    refuses it at the first run's set-up; the message named the run's line (27), it names the
+    fix's (26) and the run where it was refused."""
+    script = header() + HEAT + "run 100\n"
+    assert script.splitlines()[25].startswith("fix ht all heat/gran") and script.splitlines()[26] == "run 100"
+    r, _ = run(tmp_path, script, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "in.run:26 ('fix ht all heat/gran initial_temperature 300.', refused at " in r.stderr, r.stderr
+    assert "in.run:27's set-up) (the first run)" in r.stderr and "thermalConductivity" in r.stderr
 
 
 def test_a_command_liggghts_refuses_mid_script_is_named_with_its_line(tmp_path):
