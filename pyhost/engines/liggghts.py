@@ -24,6 +24,7 @@ from __future__ import annotations
 import atexit
 import ctypes
 import os
+import re
 import select
 import signal
 import tempfile
@@ -84,6 +85,10 @@ _ATOM = {
     "omega": (_c.c_double, 3), "torque": (_c.c_double, 3), "radius": (_c.c_double, 0), "rmass": (_c.c_double, 0),
     "id": (_c.c_int, 0), "type": (_c.c_int, 0),
 }
+
+
+WARNING_LINES = 30     # the most lines a LIGGGHTS warning is looked for in before its location
+_LOCATION = re.compile(r"\([^()\s]+:\d+\)\s*$")
 
 
 class LiggghtsError(RuntimeError):
@@ -224,8 +229,24 @@ class Liggghts:
             f.seek(start)
             text = f.read(size - start).decode(errors="replace")
         complete = text.rfind("\n") + 1               # a line still being written waits for the next call
-        self._screen_read = start + len(text[:complete].encode(errors="replace"))
-        return [ln.strip() for ln in text[:complete].splitlines() if ln.startswith("WARNING")]
+        lines = text[:complete].splitlines(keepends=True)
+        warnings, k, read = [], 0, 0
+        while k < len(lines):
+            if not lines[k].startswith("WARNING"):
+                read += len(lines[k])
+                k += 1
+                continue
+            # a warning ends at its source location, "(./src/contact_models.h:364)": LIGGGHTS'
+            # whitelist warning is "WARNING: " and then 8 lines of text before it
+            end = next((j for j in range(k, min(k + WARNING_LINES, len(lines))) if _LOCATION.search(lines[j])), None)
+            if end is None and len(lines) - k < WARNING_LINES:
+                break                   # the rest of it is still being written: read it at the next call
+            end = k if end is None else end
+            warnings.append(" ".join(" ".join(ln.split()) for ln in lines[k:end + 1] if ln.strip()))
+            read += sum(len(ln) for ln in lines[k:end + 1])
+            k = end + 1
+        self._screen_read = start + len(text[:read].encode(errors="replace"))
+        return warnings
 
     def _watch(self) -> None:
         self.helper.collheat_watch_exit(self.ptr, str(self.log).encode())

@@ -188,6 +188,33 @@ def test_liggghts_warnings_are_shown_once(tmp_path):
     assert len(shown) == 1 and "each warning is shown once" in shown[0]
 
 
+def test_a_warning_of_several_lines_is_shown_whole(tmp_path):
+    """LIGGGHTS' whitelist warning (a contact model with rolling friction) is 'WARNING: ' and
+    8 more lines up to its source location; it was echoed as 'LIGGGHTS WARNING:' and nothing
+    else. The host shows it whole, on one line, ending at that location."""
+    script = (header().replace("model hertz tangential history\npair_coeff",
+                               "model hertz tangential history rolling_friction epsd2\npair_coeff")
+              .replace("pair_style", "fix m7 all property/global coefficientRollingFriction peratomtypepair 1 0.1\n"
+                                     "pair_style") + "run 100\n")
+    r, _ = run(tmp_path, script, toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    [shown] = [ln for ln in r.stdout.splitlines() if ln.startswith("LIGGGHTS WARNING")]
+    print(shown)
+    assert shown.startswith("LIGGGHTS WARNING: The contact model you specified is not located in any whitelist. ")
+    assert "needs to be recompiled to generate the optimized code. (./src/contact_models.h:364) (after " in shown
+
+
+def test_the_resolved_scene_is_one_line_naming_its_file(tmp_path):
+    """The resolved scene, 150 lines of JSON printed before the run, is in OUT/scene.json;
+    the screen says so in one line."""
+    r, _ = run(tmp_path, header() + "run 100\n", toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    lines = r.stdout.splitlines()
+    assert lines[0] == f"scene: {tmp_path / 'case.toml'}, resolved in {tmp_path / 'out' / 'scene.json'}"
+    assert lines[1].startswith("active effects: ")
+    assert json.loads((tmp_path / "out" / "scene.json").read_text())["path"] == str(tmp_path / "case.toml")
+
+
 @pytest.mark.parametrize("runs, message", [
     ("run 1e11\n", "run 1e11: 100000000000 steps is outside 0 .. 2^31 - 1"),
     ("run -100\n", "run -100: -100 steps is outside 0 .. 2^31 - 1"),
