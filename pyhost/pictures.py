@@ -2,9 +2,17 @@
 from __future__ import annotations
 
 import csv
+import ctypes.util
+import os
 from pathlib import Path
 
 import numpy as np
+
+# Pictures are drawn off screen. Without a display VTK first tries X, prints a coloured
+# "bad X server connection" warning, then falls back to EGL: with EGL there, go to it at once
+# (before VTK is imported; a user's own choice of window stays).
+if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY") and ctypes.util.find_library("EGL"):
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 
 def warm_up() -> None:
