@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import atexit
 import ctypes
+import faulthandler
 import os
 import re
 import select
@@ -373,6 +374,10 @@ class Liggghts:
             pid = os.fork()
             if pid == 0:  # the copy: never returns into Python's normal flow
                 try:
+                    # a copy that dies of a fault is reported by the parent ("LIGGGHTS crashed
+                    # on ..."): no Python traceback dump of the copy (faulthandler, on under
+                    # pytest and PYTHONFAULTHANDLER) on the user's terminal
+                    faulthandler.disable()
                     self.helper.collheat_watch_exit(self.ptr, b"")  # the parent reports, not the copy
                     self.helper.collheat_trial_output(self.ptr, str(trial).encode())
                     failed = call()
