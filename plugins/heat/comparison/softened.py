@@ -91,7 +91,8 @@ def heat_gran(v0, pair, dem, area_correction: bool) -> dict:
         root_area = np.sqrt(contact_area(delta, R1[s, None], R2[s, None]))
         Q[s] = root_area @ w
     Q *= 4.0 * k1 * k2 / (k1 + k2) * t_s * dT
-    return dict(Q=Q.reshape(shape), t_coll=(tc * t_s).reshape(shape), e=np.full(shape, np.nan))
+    return dict(Q=Q.reshape(shape), t_coll=(tc * t_s).reshape(shape), e=np.full(shape, np.nan),
+                delta_max=(scale * d_s * x.max()).reshape(shape))
 
 
 MODEL = ComparisonModel(
