@@ -457,6 +457,7 @@ def strict_json(text):
 @pytest.mark.parametrize("args,flag", [(["--v0", "1e6"], "delta_max_exceeds_radius"),
                                        (["--v0", "1e6", "--method", "fast"], "delta_max_exceeds_radius"),
                                        (["--v0", "1e4", "--method", "fit"], "outside_fit_range"),
+                                       (["--v0", "4000", "--model", "hertz"], "delta_max_exceeds_radius"),
                                        (["--v0", "1", "--b1", "1.5", "--b2", "3", "--method", "fit"],
                                         "outside_fit_range")])
 def test_collision_outside_validity_is_flagged_in_valid_json(args, flag, capsys):
