@@ -88,6 +88,23 @@ def load_post_scene(path) -> PostScene:
                      walls)
 
 
+def run_output(out: Path) -> str | None:
+    """What marks ``out`` as a run's output folder (``pyhost run``), which post must not write
+    into: its scene.json, a file only a run writes (history.csv, collisions.csv, checkpoint,
+    ...: a run of an older version or stopped on a full disk has no scene.json), or a
+    summary.json that is not post's (a run's has a status, post's its frames); None if
+    nothing does."""
+    from pyhost.outdir import RUN_FILES
+    for name in RUN_FILES:
+        if name not in ("summary.json", "vtk") and (out / name).exists():
+            return name
+    try:
+        summary = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return "summary.json with a status" if not isinstance(summary, dict) or "frames" not in summary else None
+
+
 class ScriptDem:
     """The DEM values the script that wrote the dumps sets (``fix ... property/global``, plain
     numbers; ``pyhost.dumps.Script.globals``), behind the part of the engine's interface that
@@ -512,8 +529,9 @@ class Post:
 
     # -- the job ------------------------------------------------------------------------------------
     def run(self) -> dict:
-        if (self.out / "scene.json").is_file():
-            raise ValueError(f"--out {self.out}: holds the output of a run (scene.json), whose summary.json post "
+        found = run_output(self.out)
+        if found is not None:
+            raise ValueError(f"--out {self.out}: holds the output of a run ({found}), whose summary.json post "
                              "would replace: give post a folder of its own")
         self.out.mkdir(parents=True, exist_ok=True)
         try:

@@ -330,18 +330,30 @@ def test_offline_agrees_with_the_online_run(pour_dumps, tmp_path):
     assert np.abs(Q_off[~wall]).sum() == pytest.approx(np.abs(Q_on[~wall]).sum(), rel=1e-3)
 
 
-def test_out_holding_a_run_is_refused(tmp_path):
-    """post writes a summary.json of its own: pointed at a run's output folder (scene.json),
-    it refuses instead of replacing the run's summary."""
+@pytest.mark.parametrize("files, named", [(("scene.json",), "scene.json"),
+                                          (("history.csv", "collisions.csv"), "collisions.csv"),
+                                          (("collisions/schema.json",), "collisions"),
+                                          ((), "summary.json with a status")],
+                         ids=["scene.json", "no scene.json", "binary log", "summary only"])
+def test_out_holding_a_run_is_refused(tmp_path, files, named):
+    """post writes a summary.json of its own: pointed at a run's output folder, it refuses
+    instead of replacing the run's summary, whatever marks the folder as a run's. A run's
+    folder without scene.json (an older run's, one stopped on a full disk) was written over.
+    post's own folder it writes again."""
     (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1, 2]\ntemperature = 300"))
     (tmp_path / "run").mkdir()
-    (tmp_path / "run" / "scene.json").write_text("{}")
+    for name in files:
+        (tmp_path / "run" / name).parent.mkdir(exist_ok=True)
+        (tmp_path / "run" / name).write_text("{}")
     (tmp_path / "run" / "summary.json").write_text('{"status": "completed"}')
     (tmp_path / "d.dump").write_text(HEAD.format(step=0) + "1 1 0.005 0.005 0.005 0 0 0 0.001\n"
                                      "2 1 0.002 0.002 0.002 0 0 0 0.001\n")
     r = post(tmp_path / "d.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-5", "--out", tmp_path / "run")
-    assert r.returncode == 2 and "holds the output of a run (scene.json)" in r.stderr
+    assert r.returncode == 2 and f"holds the output of a run ({named})" in r.stderr, r.stderr
     assert json.loads((tmp_path / "run" / "summary.json").read_text()) == {"status": "completed"}
+    for again in range(2):
+        r = post(tmp_path / "d.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-5", "--out", tmp_path / "own")
+        assert r.returncode == 0, r.stderr
 
 
 @pytest.mark.engines
