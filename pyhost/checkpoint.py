@@ -43,7 +43,7 @@ import numpy as np
 
 from pyhost.cli import UserError
 from pyhost.outdir import write_atomic
-from pyhost.output import check_logs
+from pyhost.output import check_logs, naming
 
 FOLDER, RESTART, FLUID, FORMAT = "checkpoint", "dem.restart", "fluid", 1
 FILES = (RESTART, "host.npz", "host.json")
@@ -78,23 +78,11 @@ def write(coupling) -> Path:
     final, new, old = out / FOLDER, out / ".checkpoint.new", out / ".checkpoint.old"
     shutil.rmtree(new, ignore_errors=True)
     new.mkdir()
-    ids, f, torque = dem.per_atom(("id", "f", "torque"))
-    ids = ids.astype(np.int64)
-    dem.engine_command(f"write_restart {new / RESTART}")
-    dem.run(0)                                   # set up again, then the step's own forces back
-    _put_forces(dem, ids, f, torque)
-    values, arrays = coupling.state()
-    np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **arrays)
-    write_atomic(new / "host.json", json.dumps(values, indent=1))
-    if coupling.fluid is not None:
-        coupling.fluid.save(new / FLUID)
-    files = sorted(str(p.relative_to(new)) for p in new.rglob("*") if p.is_file())
-    manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
-                    code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
-                    extend=coupling.extend,
-                    files={name: _sha256(new / name) for name in files},
-                    inputs={str(f): _sha256(Path(f)) for f in coupling.inputs})
-    write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
+    try:
+        _write_into(coupling, new)
+    except BaseException:               # a full disk, a stop: no half checkpoint left beside the last good one
+        shutil.rmtree(new, ignore_errors=True)
+        raise
     shutil.rmtree(old, ignore_errors=True)
     if final.exists():
         final.rename(old)
@@ -105,6 +93,30 @@ def write(coupling) -> Path:
     print(f"checkpoint at t = {coupling.t:.6g} s (step {dem.step}): {final}, {size / 1e6:.3g} MB, "
           f"{time.perf_counter() - start:.2f} s", flush=True)
     return final
+
+
+def _write_into(coupling, new: Path) -> None:
+    """The checkpoint's files into the folder ``new``, its manifest last."""
+    dem, scene = coupling.dem, coupling.scene
+    ids, f, torque = dem.per_atom(("id", "f", "torque"))
+    ids = ids.astype(np.int64)
+    dem.engine_command(f"write_restart {new / RESTART}")
+    dem.check_restart(new / RESTART)
+    dem.run(0)                                   # set up again, then the step's own forces back
+    _put_forces(dem, ids, f, torque)
+    values, arrays = coupling.state()
+    with naming(new / "host.npz"):
+        np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **arrays)
+    write_atomic(new / "host.json", json.dumps(values, indent=1))
+    if coupling.fluid is not None:
+        coupling.fluid.save(new / FLUID)
+    files = sorted(str(p.relative_to(new)) for p in new.rglob("*") if p.is_file())
+    manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
+                    code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
+                    extend=coupling.extend,
+                    files={name: _sha256(new / name) for name in files},
+                    inputs={str(f): _sha256(Path(f)) for f in coupling.inputs})
+    write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
 
 
 def mark_complete(out: Path) -> None:
@@ -191,6 +203,9 @@ def load(out: Path, scene, extend: float = 0.0) -> dict:
     if manifest.get("complete") and extend <= extended:
         raise UserError(f"--restart: the run in {out} is complete (t = {manifest.get('time'):.6g} s): nothing to go "
                         f"on with; --extend SECONDS{f' (above {extended:g})' if extended else ''} runs it longer")
+    # what a write cut short by a kill left (a stop or a full disk removes its own): the next
+    # checkpoint writes there anew
+    shutil.rmtree(Path(out) / ".checkpoint.new", ignore_errors=True)
     state["restart"] = folder / RESTART
     state["extend"] = extended
     state["fluid"] = folder / FLUID if scene.effects.fluid else None

@@ -38,7 +38,7 @@ from pyhost.contacts import find_contacts
 from pyhost.dem_input import script_dem_contacts
 from pyhost.dumps import Clock, DumpError, DumpReader, expand, local_compute
 from pyhost.outdir import write_atomic
-from pyhost.output import Progress, VtkSeries
+from pyhost.output import Progress, VtkSeries, naming
 from pyhost.scene import read_toml
 from pyhost.schema import Material, SceneError, Wall, build, check_types
 from pyhost.script import ScriptError
@@ -608,7 +608,7 @@ class Post:
         pair_sum = np.zeros(len(pairs))              # |Q| of the first model per type pair [J]
         times, pair_heat, last = [], [], None
         done = 0
-        with gzip.open(self.out / "collisions.csv.gz", "wt", newline="") as gz:
+        with naming(self.out / "collisions.csv.gz"), gzip.open(self.out / "collisions.csv.gz", "wt", newline="") as gz:
             out = csv.writer(gz)
             out.writerow(columns)
 

@@ -156,7 +156,9 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
         script, run = folder / "in.restart", f"run {steps} upto"
         lines = [f"read_restart {restart}" if line.startswith("read_data ") else line
                  for line in input_lines(scene, Path("-"))]
-    script.write_text("\n".join(["atom_modify sort 0 0"] + lines + [run]) + "\n")
+    from pyhost.output import naming
+    with naming(script):
+        script.write_text("\n".join(["atom_modify sort 0 0"] + lines + [run]) + "\n")
     index = {name: k for k, name in enumerate(scene.materials)}
     known = Known("id", np.r_[-1, particles.group], np.r_[np.nan, particles.temperature],
                   tuple(f"{g.material} {g.temperature:g} K" for g in scene.particles))

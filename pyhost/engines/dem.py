@@ -17,6 +17,7 @@ the arrays are LIGGGHTS' own memory and nothing needs to go back.
 """
 from __future__ import annotations
 
+import errno
 import os
 from pathlib import Path
 
@@ -464,6 +465,17 @@ class Dem:
             return
         self._order("set_random_states", states)
         set_random_states(self.lmp, states, 0, 1 if self.link is None else self.link.size)
+
+    def check_restart(self, path: Path) -> None:
+        """LIGGGHTS' restart file just written at ``path``, read back (``Liggghts.check_restart``):
+        OSError naming it if it is cut (a full disk)."""
+        if self.link is not None:
+            return                      # (no forked copy under MPI: LIGGGHTS' own fwrite errors stay unseen)
+        try:
+            self.lmp.check_restart(path)
+        except LiggghtsError as exc:
+            raise OSError(errno.EIO, f"LIGGGHTS wrote a restart it cannot read back, a full disk? ({exc})",
+                          str(path)) from None
 
     def engine_command(self, line: str) -> None:
         """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""

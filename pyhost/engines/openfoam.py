@@ -33,6 +33,7 @@ from foamlib import FoamFile
 
 from plugins import drag as drag_laws
 from pyhost.engines.fluid_case import is_time_name, start_time
+from pyhost.output import naming
 
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
 SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[2] / ".setup" / "bin" / "collheatFoam"))
@@ -289,8 +290,9 @@ class FluidSolver:
                 raise FluidError(f"the solver's write at t = {t:g} s left {len(new)} new time folders in {d}"
                                  + ("" if new else f" and {len(same)} of that time"))
             shutil.copytree(same[0], folder / d.relative_to(self.case) / same[0].name)
-        np.savez(folder / "host.npz", alpha=self._alpha, ksl=self._ksl, us=self._us, cell=self.cell,
-                 slip=self.slip, boundary_heat=self.boundary_heat)
+        with naming(folder / "host.npz"):
+            np.savez(folder / "host.npz", alpha=self._alpha, ksl=self._ksl, us=self._us, cell=self.cell,
+                     slip=self.slip, boundary_heat=self.boundary_heat)
         return t
 
     def _start_from(self, folder: Path) -> None:
