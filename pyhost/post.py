@@ -36,7 +36,7 @@ from plugins.heat.exchange import exchange_heat
 from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.contacts import find_contacts
 from pyhost.dem_input import script_dem_contacts
-from pyhost.dumps import Clock, DumpError, DumpReader, expand, local_compute
+from pyhost.dumps import Clock, DumpError, DumpReader, expand, local_compute, processor_parts
 from pyhost.outdir import write_atomic
 from pyhost.output import Progress, VtkSeries, naming
 from pyhost.scene import read_toml
@@ -353,8 +353,9 @@ class Post:
     def contact_streams(self) -> dict:
         """Contact dump files grouped by the compute their columns come from (one stream each)."""
         streams = {}
-        for p in expand(self.contacts):
-            streams.setdefault(local_compute(p), []).append(p)
+        heads, parts = processor_parts(expand(self.contacts))    # (an MPI run's files per processor)
+        for p in heads:
+            streams.setdefault(local_compute(p), []).extend([p, *parts.get(p, ())])
         return streams
 
     def dump_contacts(self, found: Found) -> None:

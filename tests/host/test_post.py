@@ -395,3 +395,55 @@ def test_progress_lines_on_a_long_job(tmp_path, capsys):
          "reading the dumps: frame 3, 0 collisions found", "replaying the dumps: heat of 0 of 1 collisions moved",
          "replaying the dumps: heat of 0 of 1 collisions moved", "replaying the dumps: heat of 0 of 1 collisions moved"]
     assert lines[2].startswith("t = 2e-05 s")
+
+
+@pytest.mark.engines
+def test_contact_dumps_written_per_processor_are_read(tmp_path):
+    """The pour on 2 MPI ranks with its contact dumps one file per step and processor
+    ('post/pair.*.%'): LIGGGHTS writes the header, with processor 0's row count, into
+    processor 0's file only, the other's file holds bare rows (or nothing). post refused
+    them ('not a dump local of a compute: '''); it reads each step's files as one frame: the
+    collisions are the first appearances counted with plain Python over both processors'
+    rows of each step (pairs listed by both, across the ranks' border, counted once)."""
+    import os
+    import shutil
+
+    from conftest import FLOOR_STL, POUR_SCRIPT
+    if shutil.which("mpirun") is None:
+        pytest.fail("no mpirun: tools/setup.sh --engines installs it")
+    local = lambda c: " ".join(f"c_{c}[{k}]" for k in range(1, 17))
+    script = (POUR_SCRIPT.format(pair=local("cp"), wall=local("cw")).replace("post/pair.* ", "post/pair.*.% ")
+              .replace("post/wall.* ", "post/wall.*.% "))
+    script = "".join(ln + "\n" for ln in script.splitlines() if not ln.startswith(("dump d2", "dump d3", "dump dv",
+                                                                                  "dump dl1", "dump dw1")))
+    (tmp_path / "post").mkdir()
+    (tmp_path / "in.pour").write_text(script)
+    (tmp_path / "floor.stl").write_text(FLOOR_STL)
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    done = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", "liggghts", "-in", "in.pour", "-log",
+                           "log.liggghts"], cwd=tmp_path, capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stdout[-2000:]
+    bare = [p for p in (tmp_path / "post").glob("pair.*.1") if p.stat().st_size]
+    assert bare and not bare[0].read_text().startswith("ITEM")          # rows without a header
+    (tmp_path / "scene.toml").write_text(GLASS + STEEL_WALL)
+    run = post(tmp_path / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
+               tmp_path / "post" / "pair.*", tmp_path / "post" / "wall.*", "--script", tmp_path / "in.pour",
+               "--out", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+
+    def first_appearances(kind, key):
+        steps = sorted({int(p.name.split(".")[1]) for p in (tmp_path / "post").glob(f"{kind}.*.0")})
+        previous, count = set(), 0
+        for step in steps:
+            rows = (tmp_path / "post" / f"{kind}.{step}.0").read_text().splitlines()[9:]
+            rows += (tmp_path / "post" / f"{kind}.{step}.1").read_text().splitlines()
+            current = {key(r.split()) for r in rows if r.strip()}
+            count += len(current - previous)
+            previous = current
+        return count
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    pairs = first_appearances("pair", lambda w: frozenset((w[12], w[13])))
+    walls = first_appearances("wall", lambda w: (w[12], w[14]))
+    print(summary["collisions"], pairs, walls)
+    assert summary["complete"] is True and summary["particles"] == 60
+    assert summary["collisions"] == {"particle_particle": pairs, "particle_wall": walls} and pairs > 50
