@@ -357,10 +357,13 @@ def test_out_holding_a_run_is_refused(tmp_path, files, named):
 
 
 @pytest.mark.engines
-def test_contact_dumps_of_another_run_are_refused(pour_dumps, tmp_path):
+@pytest.mark.parametrize("particles", ["dump.*", "fine.dump"])
+def test_contact_dumps_of_another_run_are_refused(pour_dumps, tmp_path, particles):
     """The same pour with another insertion seed: its contact dumps have the same ids and
     steps, so they used to be taken for the first run's. Their particles are elsewhere than
-    in the particle dumps at the same step: refused (exit 2) naming the file and step."""
+    in the particle dumps at the same step: refused (exit 2) naming the file and step. With
+    the particle dumps every 20 steps (fine.dump) they were still accepted: only the first 8
+    particle frames (steps 0 to 140) were kept to check against, before any contact."""
     other = tmp_path / "other"
     (other / "post").mkdir(parents=True)
     (other / "floor.stl").write_text((pour_dumps / "floor.stl").read_text())
@@ -370,15 +373,17 @@ def test_contact_dumps_of_another_run_are_refused(pour_dumps, tmp_path):
     done = subprocess.run(["liggghts", "-in", "in.pour", "-log", "log.liggghts", "-screen", "/dev/null"], cwd=other,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, (other / "log.liggghts").read_text()[-2000:]
-    (tmp_path / "scene.toml").write_text(GLASS + STEEL_WALL)
-    run = post(pour_dumps / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
+    glass = GLASS if particles == "dump.*" else GLASS.replace("types = [1, 2]", "types = [1, 2]\ntemperature = 300")
+    (tmp_path / "scene.toml").write_text(glass + STEEL_WALL)       # (fine.dump holds no f_Temp)
+    run = post(pour_dumps / "post" / particles, "--scene", tmp_path / "scene.toml", "--contacts",
                other / "post" / "pair.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / "out")
     assert run.returncode == 2, run.stderr
     assert "the contact dumps are not of the run the particle dumps are of" in run.stderr
-    assert "pair." in run.stderr and "timestep" in run.stderr
-    same = post(pour_dumps / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
+    assert f"{other / 'post' / 'pair.'}" in run.stderr and "timestep" in run.stderr
+    same = post(pour_dumps / "post" / particles, "--scene", tmp_path / "scene.toml", "--contacts",
                 pour_dumps / "post" / "pair.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / "same")
     assert same.returncode == 0, same.stderr
+    assert not any("is not checked" in w for w in json.loads((tmp_path / "same" / "summary.json").read_text())["warnings"])
 
 
 def test_progress_lines_on_a_long_job(tmp_path, capsys):
