@@ -210,9 +210,11 @@ def user_script(scene):
                 word = info.conducting_temperature(w.fix, mesh)    # the script's, at which its heat/gran conducts
                 T = dem.value(word) if word is not None and w.temperature > 0 else None
                 if T is not None and T != w.temperature:
+                    meshes = known[w.fix].meshes
+                    fix = info.fixes.get(meshes[mesh] if meshes else w.fix)     # where the script gives it
                     raise SceneError(f"{scene.path}: walls[{k}].temperature: {w.temperature:g} K, where the script "
-                                     f"gives wall {w.fix!r} {T:g} K (its fix heat/gran conducts at it): "
-                                     "one wall, one temperature")
+                                     f"gives wall {w.fix!r} {T:g} K" + (f" ({fix.where()})" if fix is not None else "")
+                                     + " (its fix heat/gran conducts at it): one wall, one temperature")
                 named[w.fix, mesh] = (materials.index(w.material), w.temperature if w.temperature > 0 else np.nan)
                 if word is not None and w.temperature == 0 and (w.fix, mesh) not in told:
                     print(f"LIGGGHTS wall {w.fix!r}: adiabatic for collision heat, though the script's fix heat/gran "

@@ -97,7 +97,8 @@ def test_growing_particles_enter_the_balance_as_a_mass_change(tmp_path):
 
 def test_heat_gran_after_the_first_run_has_its_capacities_checked(tmp_path):
     """fix heat/gran defined after 'run 0' with a thermalCapacity other than the material's:
-    exit 2 naming both values (the check used to run only at the first run)."""
+    exit 2 naming both values and the property/global's line (the check used to run only at
+    the first run; it named no line)."""
     late = """run 0
 fix ftco all property/global thermalConductivity peratomtype 5.
 fix ftca all property/global thermalCapacity peratomtype 0.1
@@ -106,7 +107,9 @@ run 200
 """
     r, _ = run(tmp_path, header() + late, toml(temperature=""))
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
-    assert "the script's thermalCapacity 0.1 differs from materials.glass.heat_capacity 840" in r.stderr
+    line = (header() + late).splitlines().index("fix ftca all property/global thermalCapacity peratomtype 0.1") + 1
+    assert f"the script's thermalCapacity 0.1 ({tmp_path / 'in.run'}:{line})" in r.stderr, r.stderr   # the fix's line
+    assert "differs from materials.glass.heat_capacity 840" in r.stderr
 
 
 def test_material_of_a_type_the_script_does_not_create_is_refused_before_the_engines(tmp_path):
