@@ -1,6 +1,8 @@
 """Engine faults of a real run through the command line: each ends with exit code 3 (a
 failed simulation, docs/exit-codes.md) and one line saying what failed and why. Fluid
-solver faults are simulated with small programs posing as collheatFoam (COLLHEAT_SOLVER)."""
+solver faults are simulated with small programs posing as collheatFoam (COLLHEAT_SOLVER).
+Then a full disk where only an engine run reaches (a script's checkpoint, the pictures),
+named with its file, and what a killed checkpoint left, removed at the restart."""
 import json
 import os
 import shutil
