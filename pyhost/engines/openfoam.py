@@ -33,7 +33,6 @@ from foamlib import FoamFile
 
 from plugins import drag as drag_laws
 from pyhost.engines.fluid_case import is_time_name, start_time
-from pyhost.output import naming
 
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
 SOLVER = Path(os.environ.get("COLLHEAT_SOLVER", Path(__file__).resolve().parents[2] / ".setup" / "bin" / "collheatFoam"))
@@ -290,9 +289,12 @@ class FluidSolver:
                 raise FluidError(f"the solver's write at t = {t:g} s left {len(new)} new time folders in {d}"
                                  + ("" if new else f" and {len(same)} of that time"))
             shutil.copytree(same[0], folder / d.relative_to(self.case) / same[0].name)
-        with naming(folder / "host.npz"):
+        try:
             np.savez(folder / "host.npz", alpha=self._alpha, ksl=self._ksl, us=self._us, cell=self.cell,
                      slip=self.slip, boundary_heat=self.boundary_heat)
+        except OSError as exc:          # a full disk names the file (pyhost.output.naming: an import cycle here)
+            exc.filename = exc.filename or str(folder / "host.npz")
+            raise
         return t
 
     def _start_from(self, folder: Path) -> None:
