@@ -43,7 +43,7 @@ import numpy as np
 
 from pyhost.cli import UserError
 from pyhost.outdir import write_atomic
-from pyhost.output import check_logs
+from pyhost.output import check_logs, naming
 
 FOLDER, RESTART, FLUID, FORMAT = "checkpoint", "dem.restart", "fluid", 1
 FILES = (RESTART, "host.npz", "host.json")
@@ -102,39 +102,10 @@ def write(coupling) -> Path:
     shutil.rmtree(new, ignore_errors=True)
     new.mkdir()
     try:
-        # with fix insert/stream, the step each atom is released at: LIGGGHTS recomputes it on
-        # reading a restart from the atom's path (for a changed time step), which can give the
-        # step before (measured: the second lot of a stream released early, impact speeds 1e-4
-        # apart after); it goes back by id with the forces
-        streams = ("release_step",) if dem.info.streams else ()
-        ids, f, torque, x, *release = dem.per_atom(("id", "f", "torque", "x") + streams)
-        ids = ids.astype(np.int64)
-        if _past_the_box(dem, x):
-            # particles past a fixed face of the box ('thermo_modify lost ignore'): LIGGGHTS drops
-            # them at its next re-neighbouring, which the set-up after write_restart is; a set-up
-            # first drops them from the restart file too (they used to stay in it and not in
-            # host.npz: "corrupt checkpoint", exit 2, at the checkpoint after a box emptied)
-            dem.engine_command("run 0 post no")
-            kept = np.isin(ids, dem.per_atom(("id",))[0])
-            ids, f, torque, release = ids[kept], f[kept], torque[kept], [r[kept] for r in release]
-        dem.engine_command(f"write_restart {new / RESTART}")
-        dem.run(0)                                   # set up again, then the step's own forces back
-        _put_forces(dem, ids, f, torque)
-        values, arrays = coupling.state()
-        np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **dict(zip(streams, release)), **arrays)
-        write_atomic(new / "host.json", json.dumps(values, indent=1))
-        if coupling.fluid is not None:
-            coupling.fluid.save(new / FLUID)
-    except BaseException:
-        shutil.rmtree(new, ignore_errors=True)      # no half-written checkpoint left beside the last good one
+        _write_into(coupling, new)
+    except BaseException:               # a full disk, a stop: no half checkpoint left beside the last good one
+        shutil.rmtree(new, ignore_errors=True)
         raise
-    files = sorted(str(p.relative_to(new)) for p in new.rglob("*") if p.is_file())
-    manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
-                    code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
-                    extend=coupling.extend,
-                    files={name: _sha256(new / name) for name in files},
-                    inputs=coupling.inputs)
-    write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
     shutil.rmtree(old, ignore_errors=True)
     if final.exists():
         final.rename(old)
@@ -152,6 +123,43 @@ def _past_the_box(dem, x) -> bool:
     lo, hi, periodic = dem.box()
     out = (x < lo) | (x > hi)
     return bool(out[:, ~np.asarray(periodic, bool)].any())
+
+
+def _write_into(coupling, new: Path) -> None:
+    """The checkpoint's files into the folder ``new``, its manifest last."""
+    dem, scene = coupling.dem, coupling.scene
+    # with fix insert/stream, the step each atom is released at: LIGGGHTS recomputes it on
+    # reading a restart from the atom's path (for a changed time step), which can give the
+    # step before (measured: the second lot of a stream released early, impact speeds 1e-4
+    # apart after); it goes back by id with the forces
+    streams = ("release_step",) if dem.info.streams else ()
+    ids, f, torque, x, *release = dem.per_atom(("id", "f", "torque", "x") + streams)
+    ids = ids.astype(np.int64)
+    if _past_the_box(dem, x):
+        # particles past a fixed face of the box ('thermo_modify lost ignore'): LIGGGHTS drops
+        # them at its next re-neighbouring, which the set-up after write_restart is; a set-up
+        # first drops them from the restart file too (they used to stay in it and not in
+        # host.npz: "corrupt checkpoint", exit 2, at the checkpoint after a box emptied)
+        dem.engine_command("run 0 post no")
+        kept = np.isin(ids, dem.per_atom(("id",))[0])
+        ids, f, torque, release = ids[kept], f[kept], torque[kept], [r[kept] for r in release]
+    dem.engine_command(f"write_restart {new / RESTART}")
+    dem.check_restart(new / RESTART)
+    dem.run(0)                                   # set up again, then the step's own forces back
+    _put_forces(dem, ids, f, torque)
+    values, arrays = coupling.state()
+    with naming(new / "host.npz"):
+        np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **dict(zip(streams, release)), **arrays)
+    write_atomic(new / "host.json", json.dumps(values, indent=1))
+    if coupling.fluid is not None:
+        coupling.fluid.save(new / FLUID)
+    files = sorted(str(p.relative_to(new)) for p in new.rglob("*") if p.is_file())
+    manifest = dict(format=FORMAT, scene=str(scene.path), scene_sha256=_sha256(Path(scene.path)),
+                    code_version=code_version(), step=dem.step, time=coupling.t, end=scene.time.end,
+                    extend=coupling.extend,
+                    files={name: _sha256(new / name) for name in files},
+                    inputs=coupling.inputs)
+    write_atomic(new / "manifest.json", json.dumps(manifest, indent=1))
 
 
 def mark_complete(out: Path) -> None:
@@ -243,6 +251,9 @@ def load(out: Path, scene, extend: float = 0.0) -> dict:
     if manifest.get("complete") and extend <= extended:
         raise UserError(f"--restart: the run in {out} is complete (t = {manifest.get('time'):.6g} s): nothing to go "
                         f"on with; --extend SECONDS{f' (above {extended:g})' if extended else ''} runs it longer")
+    # what a write cut short by a kill left (a stop or a full disk removes its own): the next
+    # checkpoint writes there anew
+    shutil.rmtree(Path(out) / ".checkpoint.new", ignore_errors=True)
     state["restart"] = folder / RESTART
     state["extend"] = extended
     state["fluid"] = folder / FLUID if scene.effects.fluid else None

@@ -99,7 +99,9 @@ def write_data(path: Path, scene: Scene, particles: Particles) -> Path:
     lines += ["", "Velocities", ""]
     lines += [" ".join(["%d"] + [NUM] * 3) % row + " 0 0 0" for row in
               zip(ids, *np.asarray(particles.velocity, float).T.tolist())]
-    path.write_text("\n".join(lines) + "\n")
+    from pyhost.output import naming
+    with naming(path):
+        path.write_text("\n".join(lines) + "\n")
     return path
 
 

@@ -307,6 +307,35 @@ def _is_number(words: list[str]) -> bool:
         return False
 
 
+def check_given_numbers(commands, setup, where_of, given: dict) -> None:
+    """A ``--var NAME VALUE`` whose value is not a number, where a command post reads as numbers
+    (a timestep, run, property/global, primitive wall, Temp set) takes it, directly or through
+    the script's variables: ValueError naming the variable, its value and the command's line.
+    (LIGGGHTS would put the word in the command; post could not read the value and used the
+    scene's instead, with exit 0.)"""
+    bad = {name: value for name, value in given.items() if not _is_number([value])}
+    if not bad:
+        return
+    needs = {}                          # a set-up variable -> the variables its definition names
+    for _, text in setup:
+        words = text.split()
+        if words[0] == "variable" and len(words) > 3:
+            needs.setdefault(words[1], set()).update(_references(" ".join(words[3:])))
+    for number, line in commands:
+        if "$" not in line or not _read_by_post(line.split()):
+            continue
+        seen, todo = set(), list(_references(line))
+        while todo:                     # the variables it names, and those they name in turn
+            name = todo.pop()
+            if name not in seen:
+                seen.add(name)
+                todo.extend(needs.get(name, ()) if name not in given else ())
+        name = next((n for n in sorted(seen) if n in bad), None)
+        if name is not None:
+            raise ValueError(f"--var {name} {bad[name]!r}: not a number, and {where_of[number]} takes it as one "
+                             f"('{line}')")
+
+
 def read_script(path, variables: dict | None = None) -> Script:
     """Reads ``timestep``, the local computes and the mesh wall fixes of a LIGGGHTS input, its
     property/globals, wall types, and the steps at which it sets particles' Temp (counted
@@ -324,6 +353,7 @@ def read_script(path, variables: dict | None = None) -> Script:
     variables = {str(k): str(v) for k, v in (variables or {}).items()}
     setup = [(number, line) for number, line in commands if line.split()[0] in SETUP_COMMANDS]
     same, why_not = setup_variables(setup, variables)
+    check_given_numbers(commands, setup, where_of, variables)
     warnings, asked = [], []
     for number, line in commands:
         if "$" not in line or not _read_by_post(line.split()):
@@ -548,6 +578,42 @@ def _vtk_step(path: Path) -> int:
     return int(digits[-1])
 
 
+def processor_parts(files) -> tuple[list, dict]:
+    """A ``dump local`` whose file name has ``%`` (an MPI run's one file per processor):
+    LIGGGHTS 3.8 writes its header, with processor 0's row count, into processor 0's file
+    only; the other processors' files hold bare rows (or nothing). Each such file goes
+    with the file of the same name but for a 0 in place of its processor number, whose
+    frame it completes: (the files with a header, {that file: its processors' files})."""
+    heads, bare = [], []
+    for p in files:
+        if p.suffix.lower() in VTK_SUFFIXES:
+            heads.append(p)
+            continue
+        try:
+            with open_text(p) as f:
+                first = f.readline()
+        except STREAM_ERRORS:
+            heads.append(p)             # (its error is said when it is read)
+            continue
+        (bare if not first.startswith("ITEM:") and (not first.strip() or _is_number(first.split()))
+         else heads).append(p)
+    parts, header_of = {}, {}
+    for h in heads:
+        tokens = re.split(r"(\d+)", h.name)
+        for k in range(1, len(tokens), 2):
+            if tokens[k] == "0":
+                header_of.setdefault((h.parent, tuple(tokens[:k]), tuple(tokens[k + 1:])), h)
+    for p in bare:
+        tokens = re.split(r"(\d+)", p.name)
+        h = next((header_of[key] for k in range(1, len(tokens), 2) if tokens[k] != "0"
+                  and (key := (p.parent, tuple(tokens[:k]), tuple(tokens[k + 1:]))) in header_of), None)
+        if h is None:
+            heads.append(p)             # (refused when read: no header, no processor 0's file given)
+        else:
+            parts.setdefault(h, []).append(p)
+    return heads, parts
+
+
 class DumpReader:
     """Frames of dump files in timestep order: ``for frame in DumpReader(paths): ...``.
 
@@ -567,7 +633,43 @@ class DumpReader:
         if boxes:
             self.warnings.append(f"{len(boxes)} box outlines of dump custom/vtk (*_boundingBox_*) not read "
                                  "as particle frames")
-        self.files = self._order([p for p in files if p not in boxes])
+        files, self.parts = processor_parts([p for p in files if p not in boxes])
+        self.files = self._order(files)
+
+    def _with_parts(self, path: Path, frames):
+        """The frames of ``path``, each completed by its processors' files' rows (``parts``)."""
+        parts = self.parts.get(path)
+        if not parts:
+            yield from frames
+            return
+        frames = list(frames)
+        if len(frames) != 1:
+            self._fail(DumpError(parts[0], None, 1, f"another processor's part of {path.name} (a dump local with "
+                                 f"'%' in its file name), whose {len(frames)} frames it cannot be split into: "
+                                 "LIGGGHTS writes the header into processor 0's file only; write one file per step "
+                                 "and processor ('dump ... local N post/pair.*.%')"))
+            yield from frames
+            return
+        frame, rows = frames[0], [frames[0].data]
+        for part in parts:
+            try:
+                with open_text(part) as f:
+                    body = [ln for ln in f.read().splitlines() if ln.strip()]
+                error = lambda problem, row, part=part: DumpError(part, frame.step, row + 1, problem)
+                data = _parse(body, len(frame.columns), error)
+                if frame.groups:
+                    self._check_local(data, frame.columns, frame.groups, error)
+            except _HeaderInRows as header:
+                self._fail(DumpError(part, frame.step, header.row + 1, "a header among the processor's rows"))
+                continue
+            except DumpError as exc:
+                self._fail(exc)
+                continue
+            except STREAM_ERRORS as exc:
+                self._fail(DumpError(part, frame.step, 0, f"unreadable ({type(exc).__name__}: {exc})"))
+                continue
+            rows.append(data)
+        yield replace(frame, data=np.concatenate(rows))
 
     def _fail(self, error: DumpError) -> None:
         if not self.skip:
@@ -585,8 +687,12 @@ class DumpReader:
         if not head[0]:
             raise DumpError(path, None, 0, "empty file")
         if head[0].strip() != "ITEM: TIMESTEP":
+            bare = _is_number(head[0].split())
             raise DumpError(path, None, 1, f"not a LIGGGHTS dump: first line {head[0].strip()[:60]!r}, "
-                                           "expected 'ITEM: TIMESTEP'")
+                                           "expected 'ITEM: TIMESTEP'"
+                            + ("; rows without a header are another processor's part of a dump local with '%' in "
+                               "its file name: give processor 0's file (the same name with 0 for the processor) "
+                               "with it" if bare else ""))
         try:
             return int(head[1])
         except ValueError:
@@ -605,7 +711,7 @@ class DumpReader:
         last = None                                     # (count, file, step) of the previous frame
         place = self.clock.counter() if self.clock is not None else None
         for path in self.files:
-            frames = self._vtk(path) if path.suffix.lower() in VTK_SUFFIXES else self._text(path)
+            frames = self._vtk(path) if path.suffix.lower() in VTK_SUFFIXES else self._with_parts(path, self._text(path))
             for frame in frames:
                 count = frame.step if place is None else place(frame.step)
                 if count is None or last is not None and count < last[0]:

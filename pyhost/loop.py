@@ -414,11 +414,18 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, f
             added = dem.prepare(heat=effects["particle_temperatures"], contacts=effects["contact_extraction"],
                                 fluid_force=fluid is not None, then=held)
         except (LiggghtsError, ScriptError) as exc:
-            raise type(exc)(f"{cmd.where()} (the first run): {exc}") from None
+            raise type(exc)(f"{refused_at(cmd, exc)} (the first run): {exc}") from None
         log("host adds to the script: " + ("; ".join(added) if added else "nothing")
             + (f" (before {held[0].where()}'s reset_timestep: LIGGGHTS takes no new fix between a restart's "
                "reset_timestep and its run)" if added and held else ""))
         return added
+
+    def refused_at(cmd, exc, when="set-up") -> str:
+        """Where a run's error is: the script's fix that LIGGGHTS' message names, refused in
+        this run's set-up or steps (LIGGGHTS checks a fix's values then, not at its line), else
+        the run."""
+        fix = dem.info.fix_named(str(exc))
+        return cmd.where() if fix is None else f"{fix.where()} ('{fix.text[:80]}', refused at {cmd.where()}'s {when})"
 
     def take():
         """The next command and how it comes: replayed, the interrupted run, or the script's own (None)."""
@@ -534,7 +541,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, f
                 try:
                     coupling.advance(n)
                 except LiggghtsError as exc:      # e.g. "Lost atoms" in a chunk not tried first
-                    raise type(exc)(f"{cmd.where()}: {exc}") from None
+                    raise type(exc)(f"{refused_at(cmd, exc, 'run')}: {exc}") from None
             dem.report_warnings(cmd)
         if coupling is not None and coupling.steps == 0:
             raise ScriptError(f"{scene.path}: the script's runs simulate no step (its last is "

@@ -27,8 +27,9 @@ from pyhost import signals
 
 
 @contextlib.contextmanager
-def _naming(path: Path):
-    """An OSError of a write (a full disk) names the file it was writing."""
+def naming(path: Path):
+    """An OSError of a write (a full disk) names the file it was writing (a failed write or
+    flush names none: the message said 'a file')."""
     try:
         yield
     except OSError as exc:
@@ -108,8 +109,9 @@ class CsvLog:
             return
         self._file = open(self.path, "w", newline="")
         self._csv = csv.writer(self._file)
-        self._csv.writerow(columns)
-        self._file.flush()
+        with naming(self.path):
+            self._csv.writerow(columns)
+            self._file.flush()
 
     @property
     def size(self) -> int:
@@ -136,7 +138,7 @@ class CsvLog:
     CHUNK = 2000            # rows per writerows call: the caller's thread gets the GIL between two
 
     def _write_now(self, rows, columns: bool = False) -> None:
-        with _naming(self.path):
+        with naming(self.path):
             if columns:
                 for k in range(0, len(rows[0]), self.CHUNK):
                     self._csv.writerows(zip(*(c[k:k + self.CHUNK].tolist() for c in rows)))
@@ -157,7 +159,8 @@ class CsvLog:
         try:
             self._wait()
         finally:
-            self._file.close()
+            with naming(self.path):
+                self._file.close()
 
 
 SCHEMA, COLUMN_FORMAT = "schema.json", 1
@@ -246,17 +249,19 @@ class ColumnLog:
                 a = np.array([codes[v] for v in values.tolist()], "<u2")[inverse.ravel()]
             else:
                 a = a.astype(_DTYPES[self.kinds[c]], copy=False)
-            with _naming(self._files[c].name):
+            with naming(self._files[c].name):
                 self._files[c].write(a.tobytes())
         if new:
             self._schema()
         for f in self._files.values():
-            f.flush()
+            with naming(f.name):
+                f.flush()
         self.rows += n
 
     def close(self) -> None:
         for f in self._files.values():
-            f.close()
+            with naming(f.name):
+                f.close()
 
 
 _DTYPES = {"f8": np.dtype("<f8"), "i8": np.dtype("<i8"), "str": np.dtype("<u2")}
@@ -390,6 +395,17 @@ def _output_writer():
     return _writer
 
 
+def _write_frame(path: Path, mesh) -> None:
+    """One frame's file, named if it cannot be written (a full disk), and then removed: the
+    index never names a half frame."""
+    try:
+        with naming(path):
+            meshio.write(path, mesh)
+    except BaseException:
+        path.unlink(missing_ok=True)
+        raise
+
+
 class VtkSeries:
     """Points with data, one file per frame, and the .pvd index of the frames so far.
     ``frames``: those of a checkpoint to continue from; later frame files are removed.
@@ -422,7 +438,7 @@ class VtkSeries:
         points = np.array(points, float)
         cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
         mesh = meshio.Mesh(points, cells, point_data={k: np.array(v) for k, v in point_data.items()})
-        self._pending = _output_writer().submit(meshio.write, self.folder / file, mesh)
+        self._pending = _output_writer().submit(_write_frame, self.folder / file, mesh)
         self.frames.append((t, file))
         if time.monotonic() - self._indexed >= self.INDEX_EVERY:
             self._index()
@@ -442,10 +458,15 @@ class VtkSeries:
         self._indexed = time.monotonic()
         index = self.folder / f"{self.name}.pvd"
         tmp = index.with_suffix(".pvd.tmp")
-        tmp.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n<Collection>\n'
-                       + "".join(f'<DataSet timestep="{t!r}" file="{f}"/>\n' for t, f in self.frames)
-                       + "</Collection>\n</VTKFile>\n")
-        tmp.replace(index)
+        try:
+            with naming(index):
+                tmp.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n<Collection>\n'
+                               + "".join(f'<DataSet timestep="{t!r}" file="{f}"/>\n' for t, f in self.frames)
+                               + "</Collection>\n</VTKFile>\n")
+                tmp.replace(index)
+        except BaseException:           # a full disk or a stop: the last whole index stays, no half one
+            tmp.unlink(missing_ok=True)
+            raise
 
 
 class Progress:

@@ -2,9 +2,19 @@
 from __future__ import annotations
 
 import csv
+import ctypes.util
+import os
 from pathlib import Path
 
 import numpy as np
+
+from pyhost.output import naming
+
+# Pictures are drawn off screen. Without a display VTK first tries X, prints a coloured
+# "bad X server connection" warning, then falls back to EGL: with EGL there, go to it at once
+# (before VTK is imported; a user's own choice of window stays).
+if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY") and ctypes.util.find_library("EGL"):
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 
 def warm_up() -> None:
@@ -100,8 +110,11 @@ def _save(fig, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    try:
+        with naming(path):
+            fig.savefig(path, dpi=100)
+    finally:
+        plt.close(fig)
     return path
 
 
@@ -223,7 +236,8 @@ def render_particles(out: Path) -> Path:
         plotter.view_isometric()
     plotter.add_text(f"t = {t * 1e3:.3g} ms", position="upper_left", font_size=12)
     path = out / "particles.png"
-    plotter.screenshot(str(path))
+    with naming(path):
+        plotter.screenshot(str(path))
     plotter.close()
     return path
 

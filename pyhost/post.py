@@ -36,9 +36,9 @@ from plugins.heat.exchange import exchange_heat
 from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.contacts import find_contacts
 from pyhost.dem_input import script_dem_contacts
-from pyhost.dumps import Clock, DumpError, DumpReader, expand, local_compute
+from pyhost.dumps import Clock, DumpError, DumpReader, expand, local_compute, processor_parts
 from pyhost.outdir import write_atomic
-from pyhost.output import Progress, VtkSeries
+from pyhost.output import Progress, VtkSeries, naming
 from pyhost.scene import read_toml
 from pyhost.schema import Material, SceneError, Wall, build, check_types
 from pyhost.script import ScriptError
@@ -86,6 +86,23 @@ def load_post_scene(path) -> PostScene:
                              f"({', '.join(FACES)})")
     return PostScene(path, materials, types, {t: materials[names[k]].temperature_of(t) for t, k in types.items()},
                      walls)
+
+
+def run_output(out: Path) -> str | None:
+    """What marks ``out`` as a run's output folder (``pyhost run``), which post must not write
+    into: its scene.json, a file only a run writes (history.csv, collisions.csv, checkpoint,
+    ...: a run of an older version or stopped on a full disk has no scene.json), or a
+    summary.json that is not post's (a run's has a status, post's its frames); None if
+    nothing does."""
+    from pyhost.outdir import RUN_FILES
+    for name in RUN_FILES:
+        if name not in ("summary.json", "vtk") and (out / name).exists():
+            return name
+    try:
+        summary = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return "summary.json with a status" if not isinstance(summary, dict) or "frames" not in summary else None
 
 
 class ScriptDem:
@@ -213,7 +230,8 @@ class Post:
                                      f"{scene.path}: their collisions are not counted")
         self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()
-        self.positions = {}             # step -> (ids, x, box, periodic) of a few particle frames
+        self.frame_steps = set()        # the steps of the particle frames
+        self.same_run = {}              # step -> a contact frame to check against the particle frame of that step
         self.summary = dict(frames=0, particles=0, collisions=dict(particle_particle=0, particle_wall=0),
                             contacts_open_at_start=0, heat_J={m: 0.0 for m in self.models}, warnings=self.warnings,
                             complete=False, temperatures=temperatures)
@@ -280,13 +298,12 @@ class Post:
                                  f"{self.scene.path} (materials.NAME.types)")
             column = self.temperature_column(f)
             self.particles.add(ids, types, f["radius"], f[column] if column else None)
-            if self.contacts and len(self.positions) < 8:       # a few frames to check contact dumps against
-                self.positions[f.step] = (ids, f.positions(), self.frame_box(f), f.periodic)
             steps.append(f.step)
             last = f
             if not self.contacts:
                 self.position_contacts(f, ids, walls, found, first, steps)
         self.summary["frames"] = len(steps)
+        self.frame_steps = set(steps)
         self.summary["particles"] = len(last) if last is not None else 0
         # the shortest interval between two frames ([s], steps): what collisions it can miss
         self.interval = (min(zip(np.diff(self.clock.time(steps)), np.diff(steps))) if len(steps) > 1 else None)
@@ -336,8 +353,9 @@ class Post:
     def contact_streams(self) -> dict:
         """Contact dump files grouped by the compute their columns come from (one stream each)."""
         streams = {}
-        for p in expand(self.contacts):
-            streams.setdefault(local_compute(p), []).append(p)
+        heads, parts = processor_parts(expand(self.contacts))    # (an MPI run's files per processor)
+        for p in heads:
+            streams.setdefault(local_compute(p), []).extend([p, *parts.get(p, ())])
         return streams
 
     def dump_contacts(self, found: Found) -> None:
@@ -366,6 +384,7 @@ class Post:
                     first.new(np.empty(0, np.int64))        # an empty frame ends every contact
         if intervals:
             self.interval = min(intervals)
+        self.check_same_run()
 
     def wall_index(self, cid: str) -> int:
         fixes = [k for k, w in enumerate(self.scene.walls) if w.fix]
@@ -381,18 +400,40 @@ class Post:
                              f"to needs exactly one wall with 'fix', or --script; {len(fixes)} have one")
         return fixes[0]
 
-    def check_same_run(self, f, ids_i) -> None:
-        """A contact frame at a step the particle dumps also have: its particles must be where
+    SAME_RUN_FRAMES = 8     # contact frames checked against the particle dumps
+
+    def keep_for_same_run(self, f, ids_i) -> None:
+        """The first few contact frames with rows at a step the particle dumps also have, for
+        ``check_same_run``."""
+        if f.step in self.frame_steps and f.step not in self.same_run and len(self.same_run) < self.SAME_RUN_FRAMES:
+            self.same_run[f.step] = (f.file, f.timestep, f.line, ids_i.copy(), f.vector("x_i").copy())
+
+    def check_same_run(self) -> None:
+        """Contact frames at steps the particle dumps also have: their particles must be where
         those dumps put them (contact dumps of another run with the same ids would otherwise
-        be taken for this one's). Tolerance: the dumps' 6 significant digits."""
-        if f.step not in self.positions:
+        be taken for this one's). The particle dumps are read again up to the last such step:
+        only the first 8 particle frames were kept, so a run whose first contacts come later
+        (particle dumps every 20 steps of a pour) was never checked. Tolerance: the dumps' 6
+        significant digits. A warning when no contact frame with rows shares a step with them."""
+        if not self.same_run:
+            self.warnings.append("no contact frame with contacts is at a step of the particle dumps: that the "
+                                 "contact dumps are of the run the particle dumps are of is not checked")
             return
-        ids, x, box, periodic = self.positions.pop(f.step)
+        pending = dict(self.same_run)
+        for f in DumpReader(self.dumps, clock=self.clock, skip_bad_frames=self.skip, require=("id", "position")):
+            if f.step in pending:
+                self.compare_positions(pending.pop(f.step), f)
+            if not pending or f.step > max(pending):
+                return
+
+    def compare_positions(self, contact, f) -> None:
+        file, timestep, line, ids_i, x_i = contact
+        ids, x, box, periodic = f["id"].astype(np.int64), f.positions(), self.frame_box(f), f.periodic
         at = np.full(int(max(ids.max(initial=0), ids_i.max(initial=0))) + 1, -1)
         at[ids] = np.arange(len(ids))
         rows = at[ids_i]
         seen = rows >= 0
-        d = f.vector("x_i")[seen] - x[rows[seen]]
+        d = x_i[seen] - x[rows[seen]]
         if box is not None:
             size = box[:, 1] - box[:, 0]
             d -= np.where(periodic, size * np.round(d / size), 0.0)
@@ -403,14 +444,14 @@ class Post:
         far = np.flatnonzero(np.linalg.norm(d, axis=1) > tol)
         if len(far):
             k = far[0]
-            raise DumpError(f.file, f.timestep, f.line,
-                            f"particle {ids_i[seen][k]} is at {f.vector('x_i')[seen][k].tolist()} m here and at "
+            raise DumpError(file, timestep, line,
+                            f"particle {ids_i[seen][k]} is at {x_i[seen][k].tolist()} m here and at "
                             f"{x[rows[seen][k]].tolist()} m in the particle dumps at the same step: the contact "
                             "dumps are not of the run the particle dumps are of")
 
     def add_dump_contacts(self, f, cid, first, found, window) -> None:
         ids_i = self.checked_ids(f, f["id_i"])
-        self.check_same_run(f, ids_i)
+        self.keep_for_same_run(f, ids_i)
         r_i = self.particles.radius[ids_i]
         if f.kind == "pair":
             ids_j = self.checked_ids(f, f["id_j"])
@@ -512,8 +553,9 @@ class Post:
 
     # -- the job ------------------------------------------------------------------------------------
     def run(self) -> dict:
-        if (self.out / "scene.json").is_file():
-            raise ValueError(f"--out {self.out}: holds the output of a run (scene.json), whose summary.json post "
+        found = run_output(self.out)
+        if found is not None:
+            raise ValueError(f"--out {self.out}: holds the output of a run ({found}), whose summary.json post "
                              "would replace: give post a folder of its own")
         self.out.mkdir(parents=True, exist_ok=True)
         try:
@@ -590,7 +632,7 @@ class Post:
         pair_sum = np.zeros(len(pairs))              # |Q| of the first model per type pair [J]
         times, pair_heat, last = [], [], None
         done = 0
-        with gzip.open(self.out / "collisions.csv.gz", "wt", newline="") as gz:
+        with naming(self.out / "collisions.csv.gz"), gzip.open(self.out / "collisions.csv.gz", "wt", newline="") as gz:
             out = csv.writer(gz)
             out.writerow(columns)
 

@@ -13,6 +13,7 @@ walls (geometry of a primitive wall, meshes of a mesh wall), contact computes, h
 """
 from __future__ import annotations
 
+import re
 import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -624,6 +625,7 @@ class ScriptInfo:
     mesh_motions: list = field(default_factory=list)    # ids of the fix move/mesh defined now
     streams: list = field(default_factory=list)         # ids of the fix insert/stream defined now
     randoms: list = field(default_factory=list)         # "what id" of insertion's random generators
+    fixes: dict = field(default_factory=dict)           # fix id -> the Command that defined it (defined now)
 
     def wall_type(self, fix: str, mesh: int = 0) -> int | None:
         """The LIGGGHTS atom type of a wall fix's primitive, or of its mesh number ``mesh``."""
@@ -650,6 +652,20 @@ class ScriptInfo:
         found = [wall.temperature] if wall.primitive is not None else [self.mesh_temperatures.get(m) for m in wall.meshes]
         return [t for t in found if t is not None]
 
+    def fix_named(self, message: str) -> Command | None:
+        """The script's fix (defined now) that LIGGGHTS' error ``message`` names, by its style
+        ("requested by heat/gran": the last defined of that style) or by its id ("fix ID",
+        'ID'), so that a fix refused at a run's set-up is named at its own line, not the
+        run's; None if it names none."""
+        ours = [c for c in self.fixes.values() if c.file != "(host)"]
+        for c in reversed(ours):
+            if "/" in c.words[3] and re.search(rf"(?<![\w/]){re.escape(c.words[3])}(?![\w/])", message):
+                return c
+        for c in reversed(ours):
+            if re.search(rf"(?i:fix)\s+{re.escape(c.words[1])}\b|['\"]{re.escape(c.words[1])}['\"]", message):
+                return c
+        return None
+
     def _random(self, key: str, defined: bool) -> None:
         if key in self.randoms:
             self.randoms.remove(key)
@@ -660,6 +676,7 @@ class ScriptInfo:
         w = cmd.words
         if w[0] == "fix" and len(w) >= 4:
             style = w[3]
+            self.fixes[w[1]] = cmd
             if style == "wall/gran":
                 self.walls[w[1]] = parse_wall(cmd)
             elif style.startswith("mesh/surface") and "type" in w:
@@ -680,6 +697,7 @@ class ScriptInfo:
                 self._random(f"{what} {w[1]}", True)
         elif w[0] == "unfix" and len(w) == 2:
             self.walls.pop(w[1], None)
+            self.fixes.pop(w[1], None)
             if w[1] in self.mesh_motions:
                 self.mesh_motions.remove(w[1])
             if w[1] in self.streams:

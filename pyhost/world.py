@@ -158,7 +158,9 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
         script, run = folder / "in.restart", f"run {steps} upto"
         lines = [f"read_restart {restart}" if line.startswith("read_data ") else line
                  for line in input_lines(scene, Path("-"))]
-    script.write_text("\n".join(["atom_modify sort 0 0"] + lines + [run]) + "\n")
+    from pyhost.output import naming
+    with naming(script):
+        script.write_text("\n".join(["atom_modify sort 0 0"] + lines + [run]) + "\n")
     index = {name: k for k, name in enumerate(scene.materials)}
     known = Known("id", np.r_[-1, particles.group], np.r_[np.nan, particles.temperature],
                   tuple(f"{g.material} {g.temperature:g} K" for g in scene.particles))
@@ -212,10 +214,11 @@ def user_script(scene):
             Ts = [dem.value(word) if word is not None and w.temperature > 0 else None for word in words]
             for mesh, T in enumerate(Ts):
                 if T is not None and T != w.temperature:
+                    fix = info.fixes.get(meshes[mesh] if meshes else w.fix)     # where the script gives it
                     each = ", ".join(f"{m} {'no temperature' if t is None else f'{t:g} K'}" for m, t in zip(meshes, Ts))
                     raise SceneError(f"{scene.path}: walls[{k}].temperature: {w.temperature:g} K, where the script "
-                                     f"gives wall {w.fix!r} {T:g} K (its fix heat/gran conducts at it): "
-                                     "one wall, one temperature" + (
+                                     f"gives wall {w.fix!r} {T:g} K" + (f" ({fix.where()})" if fix is not None else "")
+                                     + " (its fix heat/gran conducts at it): one wall, one temperature" + (
                                          f"; its meshes: {each} (one fix wall/gran holds all of a script's meshes "
                                          "in LIGGGHTS 3.8: give those with a temperature the entry's, or leave the "
                                          "wall out of [[walls]])" if len(meshes) > 1 else ""))

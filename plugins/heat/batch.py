@@ -68,7 +68,7 @@ def evaluate_flagged(model: str, path: str, materials: list, mat_i, mat_j, R_i, 
             pair = Pair(R1=R_i[sel], R2=R_j[sel], dT=dT[sel], **props)
             out = COMPARISON[model].heat(v0[sel], pair, dem_pair(materials[a], materials[b]))
             Q[sel], e[sel], t_coll[sel] = out["Q"], out["e"], out["t_coll"]
-            delta[sel] = out.get("delta_max", 0.0)
+            delta[sel] = out["delta_max"]
         elif path == "fast":
             pair = Pair(R1=R_i[sel], R2=R_j[sel], dT=dT[sel], **props)
             out = collide_fast(v0[sel], pair, model, outputs=("Q", "e", "t_coll", "delta_max"))

@@ -82,7 +82,7 @@ def evaluate(args) -> list[dict]:
         if model in COMPARISON:
             out = COMPARISON[model].heat(np.array(args.v0), pair, dem_from_args(args, model))
             rows += [{"model": model, "v0": v, "Q": float(out["Q"][j]), "t_coll": float(out["t_coll"][j]),
-                      "e": None} for j, v in enumerate(args.v0)]
+                      "delta_max": float(out["delta_max"][j]), "e": None} for j, v in enumerate(args.v0)]
         elif args.method == "fit":
             from plugins.heat.fit import collide_fit
             out = collide_fit(np.array(args.v0), pair, model)

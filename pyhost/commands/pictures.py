@@ -62,7 +62,8 @@ if __name__ == "__main__":      # what `run` starts: the same, without building 
             sys.exit(0)                  # the run failed: no pictures
     try:
         code = run(argparse.Namespace(out=Path(sys.argv[1])))
-    except UserError as exc:
-        sys.exit(f"error: {exc}")
+    except (UserError, OSError) as exc:      # (a full disk: the picture's file named, no traceback)
+        from pyhost.exitcodes import classify
+        sys.exit(f"error: {classify(exc)[1]}")
     sys.stdout.flush()
     os._exit(code)       # the pictures are written: skip tearing down VTK and matplotlib (0.2 s)

@@ -85,9 +85,10 @@ def run_case(args, link) -> int:
             scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=scene.time.end + extend))
     else:
         prepare_output(out, args.overwrite)
-    print("scene:", json.dumps(resolved(scene), indent=1, default=str))
-    print("active effects:", ", ".join(k for k, on in effects.items() if on) or "none (plain DEM)")
+    # the resolved scene (about 150 lines) goes to its file; the screen names the file
     write_atomic(out / "scene.json", json.dumps(resolved(scene), indent=1, default=str))
+    print(f"scene: {scene.path}, resolved in {out / 'scene.json'}")
+    print("active effects:", ", ".join(k for k, on in effects.items() if on) or "none (plain DEM)")
     if link is not None:
         print(f"MPI: LIGGGHTS on {link.size} ranks; the host on rank 0")
     pictures = painter(out) if scene.output.pictures else None   # own process, warming up meanwhile

@@ -155,8 +155,10 @@ class EnergyBalance(Effect):
         bad = np.flatnonzero(np.abs(script / scene - 1) > 1e-12)
         if len(bad):
             t = types[bad[0]]
+            fix = loop.dem.info.fixes.get(loop.dem.info.globals.get("thermalCapacity"))
             raise ScriptError(f"{loop.scene.path}: atom type {t}: the script's thermalCapacity {script[bad[0]]:g} "
-                              f"differs from materials.{list(loop.scene.materials)[loop.type_material[t]]}"
+                              + (f"({fix.where()}) " if fix is not None else "")
+                              + f"differs from materials.{list(loop.scene.materials)[loop.type_material[t]]}"
                               f".heat_capacity {scene[bad[0]]:g} J/(kg K): give both the same value")
 
     def flush(self) -> None:

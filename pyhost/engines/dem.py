@@ -17,6 +17,7 @@ the arrays are LIGGGHTS' own memory and nothing needs to go back.
 """
 from __future__ import annotations
 
+import errno
 import os
 from pathlib import Path
 
@@ -117,12 +118,34 @@ class Dem:
 
     def command(self, cmd: Command) -> None:
         """Run one script command; a refusal names the script's file and line."""
+        self.check_temperature_set(cmd)
         try:
             self._raw(cmd.text)
         except LiggghtsError as exc:
             raise LiggghtsError(f"{cmd.where()}: {exc}{refusal_hint(cmd, str(exc))}") from None
         self.info.learn(cmd)
+        if cmd.name == "timestep" and not self.dt > 0:     # LIGGGHTS takes it; every run would then stand still
+            raise ScriptError(f"{cmd.where()}: '{cmd.text}': the time step is {self.dt:g} s: give the script a "
+                              "positive 'timestep'")
         self.report_warnings(cmd)
+
+    def check_temperature_set(self, cmd: Command) -> None:
+        """A ``set ... property/atom Temp VALUE`` at or below 0 K is refused before it runs,
+        naming the script's line (LIGGGHTS takes it; the heat models, the energy balance and
+        a particle's start, refused at 0 K, need kelvins above 0). A per-atom ``v_name`` is
+        left to the check of the particles' start."""
+        w = cmd.words
+        if not (w and w[0] == "set" and "property/atom" in w[:-2] and w[w.index("property/atom") + 1] == "Temp"):
+            return
+        word = w[w.index("property/atom") + 2]
+        if word.startswith("v_"):
+            return
+        try:
+            T = self.value(word)
+        except ScriptError:
+            return                      # LIGGGHTS' own refusal of the command names it
+        if not T > 0:
+            raise ScriptError(f"{cmd.where()}: '{cmd.text}': {T:g} K: temperatures must be above 0 K")
 
     def commands(self, cmds: list[Command]) -> None:
         """The script's commands up to its next ``run`` (none of them a run), in order. A serial
@@ -462,6 +485,17 @@ class Dem:
 
     def _insertions(self) -> list[str]:
         return [key.split(" ", 1)[1] for key in self.info.randoms if key.startswith("insert ")]
+
+    def check_restart(self, path: Path) -> None:
+        """LIGGGHTS' restart file just written at ``path``, read back (``Liggghts.check_restart``):
+        OSError naming it if it is cut (a full disk)."""
+        if self.link is not None:
+            return                      # (no forked copy under MPI: LIGGGHTS' own fwrite errors stay unseen)
+        try:
+            self.lmp.check_restart(path)
+        except LiggghtsError as exc:
+            raise OSError(errno.EIO, f"LIGGGHTS wrote a restart it cannot read back, a full disk? ({exc})",
+                          str(path)) from None
 
     def engine_command(self, line: str) -> None:
         """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""

@@ -46,6 +46,10 @@ class DemEngine(Protocol):
     def engine_command(self, line: str) -> None:
         """Run a command of the host's own (write_restart, ...)."""
 
+    def check_restart(self, path) -> None:
+        """The engine's restart file just written at ``path`` is whole (read back): OSError
+        naming it if not (a full disk the engine did not report)."""
+
     def prepare(self, heat: bool, contacts: bool | None = None, fluid_force: bool = False,
                 then=()) -> list[str]:
         """Before the first run: add what the host needs (temperatures, the contact event

@@ -23,7 +23,9 @@ from __future__ import annotations
 
 import atexit
 import ctypes
+import faulthandler
 import os
+import re
 import select
 import signal
 import tempfile
@@ -85,6 +87,10 @@ _ATOM = {
     "omega": (_c.c_double, 3), "torque": (_c.c_double, 3), "radius": (_c.c_double, 0), "rmass": (_c.c_double, 0),
     "id": (_c.c_int, 0), "type": (_c.c_int, 0),
 }
+
+
+WARNING_LINES = 30     # the most lines a LIGGGHTS warning is looked for in before its location
+_LOCATION = re.compile(r"\([^()\s]+:\d+\)\s*$")
 
 
 class LiggghtsError(RuntimeError):
@@ -225,8 +231,24 @@ class Liggghts:
             f.seek(start)
             text = f.read(size - start).decode(errors="replace")
         complete = text.rfind("\n") + 1               # a line still being written waits for the next call
-        self._screen_read = start + len(text[:complete].encode(errors="replace"))
-        return [ln.strip() for ln in text[:complete].splitlines() if ln.startswith("WARNING")]
+        lines = text[:complete].splitlines(keepends=True)
+        warnings, k, read = [], 0, 0
+        while k < len(lines):
+            if not lines[k].startswith("WARNING"):
+                read += len(lines[k])
+                k += 1
+                continue
+            # a warning ends at its source location, "(./src/contact_models.h:364)": LIGGGHTS'
+            # whitelist warning is "WARNING: " and then 8 lines of text before it
+            end = next((j for j in range(k, min(k + WARNING_LINES, len(lines))) if _LOCATION.search(lines[j])), None)
+            if end is None and len(lines) - k < WARNING_LINES:
+                break                   # the rest of it is still being written: read it at the next call
+            end = k if end is None else end
+            warnings.append(" ".join(" ".join(ln.split()) for ln in lines[k:end + 1] if ln.strip()))
+            read += sum(len(ln) for ln in lines[k:end + 1])
+            k = end + 1
+        self._screen_read = start + len(text[:read].encode(errors="replace"))
+        return warnings
 
     def _watch(self) -> None:
         self.helper.collheat_watch_exit(self.ptr, str(self.log).encode())
@@ -302,6 +324,16 @@ class Liggghts:
         self._execute(str(path), LiggghtsError, is_file=True)
         self._changed = self._new = True
 
+    def check_restart(self, path: str | os.PathLike) -> None:
+        """A restart file just written, read back whole in a forked copy: LIGGGHTS writes it
+        with fwrite and ignores a failed write, so a full disk left a cut file (8000 of 10,441
+        bytes) and a checkpoint that said nothing. LiggghtsError with LIGGGHTS' message if it
+        cannot read it (serial only: see ``check``)."""
+        def call() -> int:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), 1)   # (the copy's only: a fix's read prints "version 3 8")
+            return self._call("clear") or self._call(f"read_restart {path}")
+        self._tried(call, f"read_restart {path}")
+
     def set_up_next(self) -> None:
         """The next run starts with a full set-up (a script's ``run``, whose default ``pre yes``
         recomputes the forces from a fresh neighbour list, as plain LIGGGHTS does at each run)."""
@@ -362,6 +394,10 @@ class Liggghts:
             pid = os.fork()
             if pid == 0:  # the copy: never returns into Python's normal flow
                 try:
+                    # a copy that dies of a fault is reported by the parent ("LIGGGHTS crashed
+                    # on ..."): no Python traceback dump of the copy (faulthandler, on under
+                    # pytest and PYTHONFAULTHANDLER) on the user's terminal
+                    faulthandler.disable()
                     self.helper.collheat_watch_exit(self.ptr, b"")  # the parent reports, not the copy
                     self.helper.collheat_trial_output(self.ptr, str(trial).encode())
                     failed = call()

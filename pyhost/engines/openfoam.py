@@ -324,8 +324,12 @@ class FluidSolver:
                 raise FluidError(f"the solver's write at t = {t:g} s left {len(new)} new time folders in {d}"
                                  + ("" if new else f" and {len(same)} of that time"))
             shutil.copytree(same[0], folder / d.relative_to(self.case) / same[0].name)
-        np.savez(folder / "host.npz", alpha=self._alpha, ksl=self._ksl, us=self._us, cell=self.cell,
-                 slip=self.slip, boundary_heat=self.boundary_heat)
+        try:
+            np.savez(folder / "host.npz", alpha=self._alpha, ksl=self._ksl, us=self._us, cell=self.cell,
+                     slip=self.slip, boundary_heat=self.boundary_heat)
+        except OSError as exc:          # a full disk names the file (pyhost.output.naming: an import cycle here)
+            exc.filename = exc.filename or str(folder / "host.npz")
+            raise
         return t
 
     def _start_from(self, folder: Path) -> None:

@@ -97,7 +97,8 @@ def test_growing_particles_enter_the_balance_as_a_mass_change(tmp_path):
 
 def test_heat_gran_after_the_first_run_has_its_capacities_checked(tmp_path):
     """fix heat/gran defined after 'run 0' with a thermalCapacity other than the material's:
-    exit 2 naming both values (the check used to run only at the first run)."""
+    exit 2 naming both values and the property/global's line (the check used to run only at
+    the first run; it named no line)."""
     late = """run 0
 fix ftco all property/global thermalConductivity peratomtype 5.
 fix ftca all property/global thermalCapacity peratomtype 0.1
@@ -106,7 +107,9 @@ run 200
 """
     r, _ = run(tmp_path, header() + late, toml(temperature=""))
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
-    assert "the script's thermalCapacity 0.1 differs from materials.glass.heat_capacity 840" in r.stderr
+    line = (header() + late).splitlines().index("fix ftca all property/global thermalCapacity peratomtype 0.1") + 1
+    assert f"the script's thermalCapacity 0.1 ({tmp_path / 'in.run'}:{line})" in r.stderr, r.stderr   # the fix's line
+    assert "differs from materials.glass.heat_capacity 840" in r.stderr
 
 
 def test_material_of_a_type_the_script_does_not_create_is_refused_before_the_engines(tmp_path):
@@ -188,6 +191,33 @@ def test_liggghts_warnings_are_shown_once(tmp_path):
     assert len(shown) == 1 and "each warning is shown once" in shown[0]
 
 
+def test_a_warning_of_several_lines_is_shown_whole(tmp_path):
+    """LIGGGHTS' whitelist warning (a contact model with rolling friction) is 'WARNING: ' and
+    8 more lines up to its source location; it was echoed as 'LIGGGHTS WARNING:' and nothing
+    else. The host shows it whole, on one line, ending at that location."""
+    script = (header().replace("model hertz tangential history\npair_coeff",
+                               "model hertz tangential history rolling_friction epsd2\npair_coeff")
+              .replace("pair_style", "fix m7 all property/global coefficientRollingFriction peratomtypepair 1 0.1\n"
+                                     "pair_style") + "run 100\n")
+    r, _ = run(tmp_path, script, toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    [shown] = [ln for ln in r.stdout.splitlines() if ln.startswith("LIGGGHTS WARNING")]
+    print(shown)
+    assert shown.startswith("LIGGGHTS WARNING: The contact model you specified is not located in any whitelist. ")
+    assert "needs to be recompiled to generate the optimized code. (./src/contact_models.h:364) (after " in shown
+
+
+def test_the_resolved_scene_is_one_line_naming_its_file(tmp_path):
+    """The resolved scene, 150 lines of JSON printed before the run, is in OUT/scene.json;
+    the screen says so in one line."""
+    r, _ = run(tmp_path, header() + "run 100\n", toml())
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    lines = r.stdout.splitlines()
+    assert lines[0] == f"scene: {tmp_path / 'case.toml'}, resolved in {tmp_path / 'out' / 'scene.json'}"
+    assert lines[1].startswith("active effects: ")
+    assert json.loads((tmp_path / "out" / "scene.json").read_text())["path"] == str(tmp_path / "case.toml")
+
+
 @pytest.mark.parametrize("runs, message", [
     ("run 1e11\n", "run 1e11: 100000000000 steps is outside 0 .. 2^31 - 1"),
     ("run -100\n", "run -100: -100 steps is outside 0 .. 2^31 - 1"),
@@ -206,9 +236,41 @@ def test_run_commands_keep_liggghts_rules(tmp_path, runs, message):
 
 
 def test_a_zero_time_step_is_refused(tmp_path):
+    """Named at its own line (17), not at the first run's (26) where it was found."""
     r, _ = run(tmp_path, header().replace("timestep 1e-5", "timestep 0") + "run 100\n", toml())
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
-    assert "the time step is 0 s" in r.stderr
+    assert "in.run:17: 'timestep 0': the time step is 0 s" in r.stderr, r.stderr
+
+
+HEAT = "fix m5 all property/global thermalCapacity peratomtype 840\nfix ht all heat/gran initial_temperature 300.\n"
+
+
+@pytest.mark.parametrize("where, value", [("before", "-50"), ("between", "-50"), ("between", "0")])
+def test_a_temperature_set_at_or_below_0_K_is_refused(tmp_path, where, value):
+    """A script's 'set ... property/atom Temp -50' (or 0), before the first run or between
+    two: LIGGGHTS takes it and the run went on at -50 K with exit 0; refused at the set's own
+    line (28 or 29) with the value, as a particle starting at 0 K is."""
+    conduct = header() + "fix m6 all property/global thermalConductivity peratomtype 1.0\n" + HEAT
+    bad = f"set group all property/atom Temp {value}\n"
+    script = conduct + (bad + "run 100\n" if where == "before" else "run 100\n" + bad + "run 100\n")
+    line = script.splitlines().index(bad.strip()) + 1
+    r, s = run(tmp_path, script, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert f"in.run:{line}: '{bad.strip()}': {value} K: temperatures must be above 0 K" in r.stderr, r.stderr
+    if where == "between":              # the run before it kept: summary.json of its 100 steps
+        assert s["steps"] == 100 and s["status"].startswith("stopped at t = ")
+
+
+def test_a_fix_refused_at_the_first_run_is_named_at_its_own_line(tmp_path):
+    """A fix heat/gran without the script's thermalConductivity: LIGGGHTS takes the fix and
+    refuses it at the first run's set-up; the message named the run's line (27), it names the
+    fix's (26) and the run where it was refused."""
+    script = header() + HEAT + "run 100\n"
+    assert script.splitlines()[25].startswith("fix ht all heat/gran") and script.splitlines()[26] == "run 100"
+    r, _ = run(tmp_path, script, toml())
+    assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "in.run:26 ('fix ht all heat/gran initial_temperature 300.', refused at " in r.stderr, r.stderr
+    assert "in.run:27's set-up) (the first run)" in r.stderr and "thermalConductivity" in r.stderr
 
 
 def test_a_command_liggghts_refuses_mid_script_is_named_with_its_line(tmp_path):

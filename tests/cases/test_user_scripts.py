@@ -168,7 +168,10 @@ def test_a_hot_script_wall_in_the_scene_gets_collision_heat_and_heat_grans_share
     assert abs(summary["energy_balance_error"]) < 1e-12
     r, _ = run(hot_floor_case(tmp_path / "other", walls.format(T=900.0)), "--test")
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
-    assert "walls[0].temperature: 900 K, where the script gives wall 'zwalls1' 1000 K" in r.stderr
+    line = next(k for k, text in enumerate((tmp_path / "other" / "heatTransfer_1" / "in.heatGran").read_text()
+                                            .splitlines(), 1) if text.startswith("fix zwalls1"))
+    assert f"walls[0].temperature: 900 K, where the script gives wall 'zwalls1' 1000 K (" in r.stderr
+    assert f"in.heatGran:{line})" in r.stderr, r.stderr          # the wall fix's own line
 
 
 @pytest.mark.skipif(not SOURCES.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")

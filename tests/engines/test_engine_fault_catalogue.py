@@ -1,6 +1,9 @@
 """Engine faults of a real run through the command line: each ends with exit code 3 (a
 failed simulation, docs/exit-codes.md) and one line saying what failed and why. Fluid
-solver faults are simulated with small programs posing as collheatFoam (COLLHEAT_SOLVER)."""
+solver faults are simulated with small programs posing as collheatFoam (COLLHEAT_SOLVER).
+Then a full disk where only an engine run reaches (a script's checkpoint, the pictures),
+named with its file, and what a killed checkpoint left, removed at the restart."""
+import json
 import os
 import shutil
 import stat
@@ -89,3 +92,108 @@ def test_fluid_solver_not_executable(tmp_path):
     r = run(tmp_path, FLUID, env={"COLLHEAT_SOLVER": str(fake)})
     assert_failed(r, "cannot start the fluid solver", str(fake))
     assert not (tmp_path / "out" / "fluid" / ".link").exists()
+
+
+POUR = """atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+region box block 0 0.02 0 0.02 0 0.02 units box
+create_box 1 box
+neighbor 0.0005 bin
+neigh_modify delay 0
+fix m1 all property/global youngsModulus peratomtype 5e6
+fix m2 all property/global poissonsRatio peratomtype 0.3
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5
+fix m4 all property/global coefficientFriction peratomtypepair 1 0.5
+pair_style gran model hertz tangential history
+pair_coeff * *
+timestep 1e-5
+fix walls all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+region fill block 0.002 0.018 0.002 0.018 0.002 0.018 units box
+fix pts all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.001
+fix pdd all particledistribution/discrete 15485867 1 pts 1.0
+fix ins all insert/pack seed 32452843 distributiontemplate pdd vel constant 0 0 0 insert_every once overlapcheck yes \
+all_in yes particles_in_region 40 region fill
+fix integr all nve/sphere
+run 2000
+"""
+GLASS = dict(types=[1], temperature=300.0, density=2500.0, youngs_modulus=63e9, poisson_ratio=0.25,
+             yield_stress=500e6, heat_capacity=840.0, conductivity=1.0)
+
+
+def limited(tmp_path, args, size):
+    """``python -m pyhost ARGS`` whose files may not exceed ``size`` bytes: a full disk."""
+    import resource
+    import signal
+
+    def small_files():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (size, size))
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    return subprocess.run([sys.executable, "-m", "pyhost", *map(str, args)], capture_output=True, text=True,
+                          cwd=ROOT, preexec_fn=small_files, timeout=300)
+
+
+def test_a_full_disk_at_a_scripts_checkpoint_is_named(tmp_path):
+    """A script's checkpoint on a full disk: LIGGGHTS' write_restart ignores its failed writes,
+    so the run went on with exit 0 and a checkpoint whose dem.restart was cut (8000 of 10,441
+    bytes: read back, 'Did not assign all atoms correctly'). The restart is now read back in a
+    forked copy: exit 2 naming dem.restart, the run's summary.json of the steps done, and no
+    .checkpoint.new left."""
+    case = tmp_path / "case"
+    case.mkdir()
+    (case / "in.run").write_text(POUR)
+    (case / "case.toml").write_text(tomli_w.dumps(dict(dem=dict(script="in.run"), effects=dict(contact_heat="A"),
+                                                       materials=dict(glass=GLASS),
+                                                       output=dict(vtk=False, pictures=False, checkpoint=0.005))))
+    r = limited(tmp_path, ["run", case, "--out", tmp_path / "out"], 8000)
+    assert r.returncode == 2, r.stdout[-2000:] + r.stderr[-2000:]
+    assert f"error: {tmp_path / 'out' / '.checkpoint.new' / 'dem.restart'}: LIGGGHTS wrote a restart it cannot read " \
+           "back, a full disk?" in r.stderr and "Traceback" not in r.stderr, r.stderr
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["status"].startswith("stopped at t = 0.005 s")
+    assert not (tmp_path / "out" / ".checkpoint.new").exists() and not (tmp_path / "out" / "checkpoint").exists()
+
+
+def test_a_full_disk_at_the_pictures_is_named(tmp_path):
+    """The run's data fit, its pictures do not: the picture process ended with a traceback
+    (PIL's) and the run said 'pictures failed (exit 1)'; it names the picture's file."""
+    case = tmp_path / "case"
+    case.mkdir()
+    (case / "case.toml").write_text(tomli_w.dumps(dict(BASE, output=dict(every=2e-5, vtk=True, pictures=True))))
+    r = limited(tmp_path, ["run", case, "--out", tmp_path / "out"], 30000)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    assert "Traceback" not in r.stderr and f"error: {tmp_path / 'out' / 'temperatures.png'}: File too large" \
+        in r.stderr, r.stderr
+    assert "warning: pictures failed (exit 1)" in r.stdout
+
+
+def test_what_a_killed_checkpoint_left_is_cleaned_at_the_restart(tmp_path):
+    """A kill during a checkpoint leaves OUT/.checkpoint.new and vtk/particles.pvd.tmp (a
+    stop or a full disk removes its own now). The restart's reading of the checkpoint removes
+    .checkpoint.new at once (it stayed until the restarted run's first checkpoint, for ever if
+    that run was killed first; the .pvd.tmp goes at its first index, written at the start);
+    the restarted run then goes on to its end."""
+    case = tmp_path / "case"
+    case.mkdir()
+    (case / "in.run").write_text(POUR)
+    (case / "case.toml").write_text(tomli_w.dumps(dict(dem=dict(script="in.run"), effects=dict(contact_heat="A"),
+                                                       materials=dict(glass=GLASS),
+                                                       output=dict(vtk=True, pictures=False, checkpoint=0.01))))
+    out = tmp_path / "out"
+    first = subprocess.run([sys.executable, "-m", "pyhost", "run", case, "--out", out], capture_output=True, text=True,
+                           cwd=ROOT, timeout=300)
+    assert first.returncode == 0, first.stderr[-2000:]
+    (out / ".checkpoint.new").mkdir()
+    (out / ".checkpoint.new" / "dem.restart").write_bytes(b"cut")
+    (out / "vtk" / "particles.pvd.tmp").write_text("<?xml")
+    from pyhost.checkpoint import load
+    from pyhost.scene import load_scene
+    load(out, load_scene(case / "case.toml"), 0.01)
+    assert not (out / ".checkpoint.new").exists() and (out / "checkpoint" / "dem.restart").is_file()
+    again = subprocess.run([sys.executable, "-m", "pyhost", "run", case, "--out", out, "--restart", "--extend", "0.01"],
+                           capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert again.returncode == 0, again.stdout[-2000:] + again.stderr[-2000:]
+    assert not (out / ".checkpoint.new").exists() and not (out / "vtk" / "particles.pvd.tmp").exists()
+    assert json.loads((out / "summary.json").read_text())["time"] == pytest.approx(0.03)

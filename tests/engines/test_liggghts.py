@@ -1,5 +1,6 @@
 """LIGGGHTS bridge on the real engine: two 2 mm glass-like spheres meeting head-on."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -225,6 +226,20 @@ def test_a_crash_in_the_trial_copy_is_reported_as_a_crash(tmp_path):
             lg._tried(lambda: ctypes.string_at(0), "x")
         lg.run(10)
         assert lg.step == 10
+
+
+def test_the_crashed_copy_prints_no_python_dump():
+    """The crash test above, run by pytest as the default test run runs it (faulthandler on):
+    the copy's fault printed "Fatal Python error: Segmentation fault" and 20 lines of Python
+    stack in the suite's output; the copy no longer dumps (the parent reports the crash)."""
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                        f"{__file__}::test_a_crash_in_the_trial_copy_is_reported_as_a_crash"],
+                       capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2], timeout=300)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    assert "1 passed" in r.stdout
+    assert "Fatal Python error" not in r.stdout + r.stderr, r.stdout + r.stderr
 
 
 def test_error_in_a_later_chunk_returns_with_liggghts_message(tmp_path):

@@ -330,25 +330,40 @@ def test_offline_agrees_with_the_online_run(pour_dumps, tmp_path):
     assert np.abs(Q_off[~wall]).sum() == pytest.approx(np.abs(Q_on[~wall]).sum(), rel=1e-3)
 
 
-def test_out_holding_a_run_is_refused(tmp_path):
-    """post writes a summary.json of its own: pointed at a run's output folder (scene.json),
-    it refuses instead of replacing the run's summary."""
+@pytest.mark.parametrize("files, named", [(("scene.json",), "scene.json"),
+                                          (("history.csv", "collisions.csv"), "collisions.csv"),
+                                          (("collisions/schema.json",), "collisions"),
+                                          ((), "summary.json with a status")],
+                         ids=["scene.json", "no scene.json", "binary log", "summary only"])
+def test_out_holding_a_run_is_refused(tmp_path, files, named):
+    """post writes a summary.json of its own: pointed at a run's output folder, it refuses
+    instead of replacing the run's summary, whatever marks the folder as a run's. A run's
+    folder without scene.json (an older run's, one stopped on a full disk) was written over.
+    post's own folder it writes again."""
     (tmp_path / "scene.toml").write_text(GLASS.replace("types = [1, 2]", "types = [1, 2]\ntemperature = 300"))
     (tmp_path / "run").mkdir()
-    (tmp_path / "run" / "scene.json").write_text("{}")
+    for name in files:
+        (tmp_path / "run" / name).parent.mkdir(exist_ok=True)
+        (tmp_path / "run" / name).write_text("{}")
     (tmp_path / "run" / "summary.json").write_text('{"status": "completed"}')
     (tmp_path / "d.dump").write_text(HEAD.format(step=0) + "1 1 0.005 0.005 0.005 0 0 0 0.001\n"
                                      "2 1 0.002 0.002 0.002 0 0 0 0.001\n")
     r = post(tmp_path / "d.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-5", "--out", tmp_path / "run")
-    assert r.returncode == 2 and "holds the output of a run (scene.json)" in r.stderr
+    assert r.returncode == 2 and f"holds the output of a run ({named})" in r.stderr, r.stderr
     assert json.loads((tmp_path / "run" / "summary.json").read_text()) == {"status": "completed"}
+    for again in range(2):
+        r = post(tmp_path / "d.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-5", "--out", tmp_path / "own")
+        assert r.returncode == 0, r.stderr
 
 
 @pytest.mark.engines
-def test_contact_dumps_of_another_run_are_refused(pour_dumps, tmp_path):
+@pytest.mark.parametrize("particles", ["dump.*", "fine.dump"])
+def test_contact_dumps_of_another_run_are_refused(pour_dumps, tmp_path, particles):
     """The same pour with another insertion seed: its contact dumps have the same ids and
     steps, so they used to be taken for the first run's. Their particles are elsewhere than
-    in the particle dumps at the same step: refused (exit 2) naming the file and step."""
+    in the particle dumps at the same step: refused (exit 2) naming the file and step. With
+    the particle dumps every 20 steps (fine.dump) they were still accepted: only the first 8
+    particle frames (steps 0 to 140) were kept to check against, before any contact."""
     other = tmp_path / "other"
     (other / "post").mkdir(parents=True)
     (other / "floor.stl").write_text((pour_dumps / "floor.stl").read_text())
@@ -358,15 +373,17 @@ def test_contact_dumps_of_another_run_are_refused(pour_dumps, tmp_path):
     done = subprocess.run(["liggghts", "-in", "in.pour", "-log", "log.liggghts", "-screen", "/dev/null"], cwd=other,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, (other / "log.liggghts").read_text()[-2000:]
-    (tmp_path / "scene.toml").write_text(GLASS + STEEL_WALL)
-    run = post(pour_dumps / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
+    glass = GLASS if particles == "dump.*" else GLASS.replace("types = [1, 2]", "types = [1, 2]\ntemperature = 300")
+    (tmp_path / "scene.toml").write_text(glass + STEEL_WALL)       # (fine.dump holds no f_Temp)
+    run = post(pour_dumps / "post" / particles, "--scene", tmp_path / "scene.toml", "--contacts",
                other / "post" / "pair.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / "out")
     assert run.returncode == 2, run.stderr
     assert "the contact dumps are not of the run the particle dumps are of" in run.stderr
-    assert "pair." in run.stderr and "timestep" in run.stderr
-    same = post(pour_dumps / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
+    assert f"{other / 'post' / 'pair.'}" in run.stderr and "timestep" in run.stderr
+    same = post(pour_dumps / "post" / particles, "--scene", tmp_path / "scene.toml", "--contacts",
                 pour_dumps / "post" / "pair.*", "--script", pour_dumps / "in.pour", "--out", tmp_path / "same")
     assert same.returncode == 0, same.stderr
+    assert not any("is not checked" in w for w in json.loads((tmp_path / "same" / "summary.json").read_text())["warnings"])
 
 
 def test_progress_lines_on_a_long_job(tmp_path, capsys):
@@ -383,3 +400,55 @@ def test_progress_lines_on_a_long_job(tmp_path, capsys):
          "reading the dumps: frame 3, 0 collisions found", "replaying the dumps: heat of 0 of 1 collisions moved",
          "replaying the dumps: heat of 0 of 1 collisions moved", "replaying the dumps: heat of 0 of 1 collisions moved"]
     assert lines[2].startswith("t = 2e-05 s")
+
+
+@pytest.mark.engines
+def test_contact_dumps_written_per_processor_are_read(tmp_path):
+    """The pour on 2 MPI ranks with its contact dumps one file per step and processor
+    ('post/pair.*.%'): LIGGGHTS writes the header, with processor 0's row count, into
+    processor 0's file only, the other's file holds bare rows (or nothing). post refused
+    them ('not a dump local of a compute: '''); it reads each step's files as one frame: the
+    collisions are the first appearances counted with plain Python over both processors'
+    rows of each step (pairs listed by both, across the ranks' border, counted once)."""
+    import os
+    import shutil
+
+    from conftest import FLOOR_STL, POUR_SCRIPT
+    if shutil.which("mpirun") is None:
+        pytest.fail("no mpirun: tools/setup.sh --engines installs it")
+    local = lambda c: " ".join(f"c_{c}[{k}]" for k in range(1, 17))
+    script = (POUR_SCRIPT.format(pair=local("cp"), wall=local("cw")).replace("post/pair.* ", "post/pair.*.% ")
+              .replace("post/wall.* ", "post/wall.*.% "))
+    script = "".join(ln + "\n" for ln in script.splitlines() if not ln.startswith(("dump d2", "dump d3", "dump dv",
+                                                                                  "dump dl1", "dump dw1")))
+    (tmp_path / "post").mkdir()
+    (tmp_path / "in.pour").write_text(script)
+    (tmp_path / "floor.stl").write_text(FLOOR_STL)
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    done = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", "liggghts", "-in", "in.pour", "-log",
+                           "log.liggghts"], cwd=tmp_path, capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stdout[-2000:]
+    bare = [p for p in (tmp_path / "post").glob("pair.*.1") if p.stat().st_size]
+    assert bare and not bare[0].read_text().startswith("ITEM")          # rows without a header
+    (tmp_path / "scene.toml").write_text(GLASS + STEEL_WALL)
+    run = post(tmp_path / "post" / "dump.*", "--scene", tmp_path / "scene.toml", "--contacts",
+               tmp_path / "post" / "pair.*", tmp_path / "post" / "wall.*", "--script", tmp_path / "in.pour",
+               "--out", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+
+    def first_appearances(kind, key):
+        steps = sorted({int(p.name.split(".")[1]) for p in (tmp_path / "post").glob(f"{kind}.*.0")})
+        previous, count = set(), 0
+        for step in steps:
+            rows = (tmp_path / "post" / f"{kind}.{step}.0").read_text().splitlines()[9:]
+            rows += (tmp_path / "post" / f"{kind}.{step}.1").read_text().splitlines()
+            current = {key(r.split()) for r in rows if r.strip()}
+            count += len(current - previous)
+            previous = current
+        return count
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    pairs = first_appearances("pair", lambda w: frozenset((w[12], w[13])))
+    walls = first_appearances("wall", lambda w: (w[12], w[14]))
+    print(summary["collisions"], pairs, walls)
+    assert summary["complete"] is True and summary["particles"] == 60
+    assert summary["collisions"] == {"particle_particle": pairs, "particle_wall": walls} and pairs > 50

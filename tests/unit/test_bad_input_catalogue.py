@@ -418,6 +418,41 @@ def test_full_disk_is_a_message_and_leaves_no_half_file(tmp_path):
     assert not (out / "scene.json").exists() and not list(out.glob(".*.tmp"))
 
 
+WRITERS = {  # id: (the writing, in a process whose files may not exceed 300 bytes; the file named)
+    "a VTK frame": ("s = VtkSeries(out / 'vtk', 'particles'); s._indexed = 1e18\n"
+                    "s.write(0.0, np.random.rand(100, 3), T=np.random.rand(100)); s.flush()", "vtk/particles_00000.vtu"),
+    "the .pvd index": ("s = VtkSeries(out / 'vtk', 'particles'); s.frames = [(k * 0.1, f'f{k}.vtu') for k in range(20)]\n"
+                       "s.flush()", "vtk/particles.pvd"),
+    "a CSV log's header": ("CsvLog(out / 'history.csv', tuple(f'column_{k}' for k in range(40)))", "history.csv"),
+    "the DEM's particle data": ("from pyhost.dem_input import place_particles, write_data\n"
+                                "from pyhost.scene import load_scene\n"
+                                "scene = load_scene(out.parent / 'case' / 'case.toml')\n"
+                                "write_data(out / 'particles.data', scene, place_particles(scene))", "particles.data"),
+}
+
+
+@pytest.mark.parametrize("name", WRITERS)
+def test_full_disk_names_the_file(name, tmp_path):
+    """A full disk (a file size limit stands in) while a run's output is written: the message
+    named 'a file' (the write or flush that failed names none); it names the file, and a
+    frame or an index cut short is not left behind."""
+    code, file = WRITERS[name]
+    case = tmp_path / "case"
+    case.mkdir()
+    scene = copy.deepcopy(BASE)
+    group(count=50)(scene)
+    (case / "case.toml").write_text(tomli_w.dumps(scene))
+    program = ("import resource, signal, numpy as np\nfrom pathlib import Path\n"
+               "from pyhost.output import CsvLog, VtkSeries\nfrom pyhost.exitcodes import classify\n"
+               f"out = Path({str(tmp_path / 'out')!r}); out.mkdir()\n"
+               "resource.setrlimit(resource.RLIMIT_FSIZE, (300, 300)); signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+               "try:\n" + "".join(f"    {line}\n" for line in code.splitlines())
+               + "except OSError as exc:\n    print(classify(exc)[1])\n")
+    r = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert r.stdout.strip() == f"{tmp_path / 'out' / file}: File too large", r.stdout + r.stderr
+    assert not list((tmp_path / "out").rglob("*.vtu")) and not list((tmp_path / "out").rglob("*.tmp"))
+
+
 CLI = {  # id: (arguments, exit code, words)
     "unknown command": (["fly"], 2, ["invalid choice"]),
     "run without case": (["run"], 2, ["case"]),
@@ -457,6 +492,7 @@ def strict_json(text):
 @pytest.mark.parametrize("args,flag", [(["--v0", "1e6"], "delta_max_exceeds_radius"),
                                        (["--v0", "1e6", "--method", "fast"], "delta_max_exceeds_radius"),
                                        (["--v0", "1e4", "--method", "fit"], "outside_fit_range"),
+                                       (["--v0", "4000", "--model", "hertz"], "delta_max_exceeds_radius"),
                                        (["--v0", "1", "--b1", "1.5", "--b2", "3", "--method", "fit"],
                                         "outside_fit_range")])
 def test_collision_outside_validity_is_flagged_in_valid_json(args, flag, capsys):
@@ -516,3 +552,32 @@ def test_debug_shows_the_error_itself(where, tmp_path):
     args = ["run", str(tmp_path / "missing")]
     with pytest.raises(SceneError, match="no such scene file"):
         main(["--debug", *args] if where == "before" else [*args, "--debug"])
+
+
+POST_SCENE = """[materials.glass]
+types = [1]
+density = 2500.0
+youngs_modulus = 63e9
+poisson_ratio = 0.22
+yield_stress = 500e6
+heat_capacity = 800.0
+conductivity = 1.0
+dem = { youngs_modulus = 5e6, restitution = 0.8, poisson_ratio = 0.3 }
+"""
+
+
+@pytest.mark.parametrize("script,line", [("fix m1 all property/global youngsModulus peratomtype ${E}\n", 2),
+                                         ("variable E2 equal 2*${E}\nfix m1 all property/global youngsModulus "
+                                          "peratomtype ${E2}\n", 3)],
+                         ids=["used directly", "through a variable"])
+def test_post_var_not_a_number(script, line, tmp_path, capsys):
+    """``post --var E abc``, where the script's property/global takes ${E}: LIGGGHTS would put
+    the word in the command and post used the scene's modulus with exit 0; refused before any
+    dump is read, naming the variable, its value and the script's line."""
+    (tmp_path / "in.s").write_text("units si\n" + script + "timestep 1e-5\n")
+    (tmp_path / "scene.toml").write_text(POST_SCENE)
+    code, err = run_main(["post", tmp_path / "dump.*", "--scene", tmp_path / "scene.toml", "--script",
+                          tmp_path / "in.s", "--var", "E", "abc", "--out", tmp_path / "out"], capsys)
+    assert code == 2, err
+    assert_one_line(err, ["--var E 'abc'", "not a number", f"in.s: line {line}", "youngsModulus"])
+    assert not (tmp_path / "out").exists()

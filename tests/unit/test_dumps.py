@@ -324,3 +324,26 @@ def test_an_included_file_is_read_in_its_place(tmp_path):
     assert script.globals == {"youngsModulus": (f"{tmp_path / 'in.materials'}: line 1", ["peratomtype", "5e6"])}
     assert [(step, where) for step, where, _ in script.temperature_sets] == [(500, f"{tmp_path / 'in.main'}: line 4")]
     assert script.warnings == ()
+
+
+def test_a_processors_rows_go_with_processor_0s_frame(tmp_path):
+    """Files of a dump local written per processor ('%'): processor 0's holds the header (its
+    own row count, 1), processor 1's 2 bare rows; read as one frame of 3 rows. Processor 1's
+    file alone is refused for what it is, naming processor 0's file to give; a processor's
+    file beside a processor 0 file of several steps cannot be split into them."""
+    cols = [f"c_c[{k}]" for k in range(1, 4)]
+    ids = {"c": Compute("c", "pair/gran/local", ("id",))}            # id_i, id_j, periodic
+    (tmp_path / "pair.10.0").write_text(local_dump(cols, ["1 2 0"]))
+    (tmp_path / "pair.10.1").write_text("3 4 0\n5 6 1\n")
+    (tmp_path / "pair.20.0").write_text(local_dump(cols, [], step=20))
+    (tmp_path / "pair.20.1").write_text("")
+    frames = list(DumpReader(computes=ids, paths=[tmp_path / "pair.*"]))
+    assert [f.step for f in frames] == [10, 20] and frames[0].data.tolist() == [[1, 2, 0], [3, 4, 0], [5, 6, 1]]
+    assert len(frames[1]) == 0
+    with pytest.raises(DumpError, match="another processor's part of a dump local with '%' in its file name: give "
+                                        "processor 0's file"):
+        list(DumpReader(computes=ids, paths=[tmp_path / "pair.10.1"]))
+    (tmp_path / "all.0").write_text(local_dump(cols, ["1 2 0"]) + local_dump(cols, [], step=20))
+    (tmp_path / "all.1").write_text("3 4 0\n")
+    with pytest.raises(DumpError, match="whose 2 frames it cannot be split into"):
+        list(DumpReader(computes=ids, paths=[tmp_path / "all.*"]))

@@ -257,3 +257,27 @@ def test_a_stop_as_the_writer_thread_starts_leaves_it_joinable(monkeypatch):
             output._writer.shutdown()
         for t in writers:
             t.join(timeout=10)
+
+
+def test_a_stop_during_a_checkpoint_leaves_no_half_checkpoint(tmp_path):
+    """A signal that stops the run while a checkpoint is written (here, as LIGGGHTS writes its
+    restart) left OUT/.checkpoint.new beside the last good checkpoint; it is removed, and the
+    last checkpoint stays as it was."""
+    import signal
+    from types import SimpleNamespace
+
+    from pyhost import checkpoint
+    from pyhost.signals import Interrupted
+
+    (tmp_path / "checkpoint").mkdir()
+    (tmp_path / "checkpoint" / "manifest.json").write_text("{}")
+
+    def stopped(line):
+        (tmp_path / ".checkpoint.new" / "dem.restart").write_bytes(b"half")
+        raise Interrupted(signal.SIGTERM)
+    dem = SimpleNamespace(per_atom=lambda names: (np.arange(2.0), np.zeros((2, 3)), np.zeros((2, 3))),
+                          engine_command=stopped)
+    with pytest.raises(Interrupted):
+        checkpoint.write(SimpleNamespace(out=tmp_path, dem=dem, scene=None))
+    assert not (tmp_path / ".checkpoint.new").exists()
+    assert (tmp_path / "checkpoint" / "manifest.json").read_text() == "{}"

@@ -116,3 +116,17 @@ def test_the_painter_started_with_a_run_draws_when_told_and_not_otherwise(tmp_pa
     assert not list(tmp_path.glob("*.png"))
     assert draw(painter(tmp_path)) == 0
     assert (tmp_path / "temperatures.png").stat().st_size > 0 and (tmp_path / "particles.png").stat().st_size > 0
+
+
+def test_no_x_server_warning_without_a_display(tmp_path):
+    """On a machine without a display VTK printed a coloured 'bad X server connection'
+    warning on stderr before falling back to off-screen rendering; the pictures go to EGL at
+    once: stderr empty, both pictures drawn."""
+    import os
+    write_run(tmp_path, fluid=False)
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "VTK_DEFAULT_OPENGL_WINDOW")}
+    r = subprocess.run([sys.executable, "-m", "pyhost", "pictures", str(tmp_path)], capture_output=True, text=True,
+                       env=env)
+    assert r.returncode == 0, r.stderr
+    assert "X server" not in r.stderr and r.stderr == "", r.stderr
+    assert (tmp_path / "particles.png").stat().st_size > 0 and (tmp_path / "temperatures.png").stat().st_size > 0

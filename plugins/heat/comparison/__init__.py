@@ -3,8 +3,10 @@
 One module per model, file name = registry key; each defines ``MODEL``, a
 ``ComparisonModel`` whose ``heat(v0, pair, dem)`` returns, for arrays of normal impact
 speeds v0 [m/s], a dict of arrays: Q [J] (> 0 from body 1 to body 2, at the pair's dT),
-t_coll [s] (the contact time the model conducts over) and e [-], which is NaN: a
-comparison model is a side column and never gives restitution feedback.
+t_coll [s] (the contact time the model conducts over), e [-], which is NaN: a
+comparison model is a side column and never gives restitution feedback, and delta_max [m],
+the largest indentation of the contact it conducts through (flagged beyond the smaller
+radius, as models A, B and C are: ``plugins.heat.batch.evaluate_flagged``).
 
 Unlike A, B and C they are not a compression law plus a recovery law, so they have their
 own registry. ``pair`` is a ``plugins.heat.Pair`` with the real material (fields may be

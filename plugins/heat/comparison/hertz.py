@@ -40,7 +40,8 @@ def heat(v0, pair, dem=None) -> dict:
     Q_ref, t_ref = _reference()
     Q = Q_ref * (v / V_REF) ** 0.7 * pair.Q_scale
     t_coll = t_ref * (v / V_REF) ** -0.2 * pair.t_y
-    return dict(Q=Q, t_coll=t_coll, e=np.full(np.shape(Q), np.nan))
+    delta_max = (15.0 * pair.mstar * np.asarray(v0, float) ** 2 / (16.0 * pair.Estar * np.sqrt(pair.Rstar))) ** 0.4
+    return dict(Q=Q, t_coll=t_coll, e=np.full(np.shape(Q), np.nan), delta_max=delta_max)
 
 
 MODEL = ComparisonModel(

@@ -88,10 +88,13 @@ def heat_gran(v0, pair, dem, area_correction: bool) -> dict:
     for lo in range(0, len(v0), CHUNK):
         s = slice(lo, lo + CHUNK)
         delta = scale * d_s[s, None] * x
-        root_area = np.sqrt(contact_area(delta, R1[s, None], R2[s, None]))
+        # beyond the spheres' overlap (delta > 2R, an impact far outside the model's range, flagged
+        # by delta_max) the circle they cut has no area: none, not the NaN that spoilt the run's balance
+        root_area = np.sqrt(np.maximum(contact_area(delta, R1[s, None], R2[s, None]), 0.0))
         Q[s] = root_area @ w
     Q *= 4.0 * k1 * k2 / (k1 + k2) * t_s * dT
-    return dict(Q=Q.reshape(shape), t_coll=(tc * t_s).reshape(shape), e=np.full(shape, np.nan))
+    return dict(Q=Q.reshape(shape), t_coll=(tc * t_s).reshape(shape), e=np.full(shape, np.nan),
+                delta_max=(scale * d_s * x.max()).reshape(shape))
 
 
 MODEL = ComparisonModel(
