@@ -75,15 +75,40 @@ class FluidExchange(Effect):
         self.force = (np.zeros(0, np.int64), np.zeros((0, 3)))   # ids and force [N] of the last coupling
         self.gas_energy0 = 0.0
         self.up = upwards(fluid)
+        self.inlet = None               # a user's case: its inflow speed of the time (fluid_case.inlet_speed)
+        if loop.scene.fluid.case:
+            from pyhost.engines.fluid_case import inlet_speed, start_time
+            self.inlet = inlet_speed(fluid.case, start_time(fluid.case)[1] or "0")
         link = loop.dem.link
         self.overlap = overlapping(loop.scene.fluid.overlap, 1 if link is None else link.size, loop.scene.fluid.ranks)
 
     def start(self) -> None:
+        if self.loop.scene.fluid.case:
+            self.check_box()
         T_gas = self.fluid.temperature() if self.convection else None
         self.couple()
         # the solver starts from the first fluid fraction it gets (no flow displaces the gas of
         # the particles as placed): the gas's initial heat content with that fraction
         self.gas_energy0 = float(np.sum(self.fluid.heat_capacity() * T_gas)) if self.convection else 0.0
+
+    def check_box(self) -> None:
+        """A user's case: the DEM's box against the extent of the fluid's mesh (its points), said
+        once where the box reaches beyond it: a particle there has no gas, and the run stops
+        when one goes there (``left_the_mesh``). A box inside the extent can still hold places
+        the mesh has not (a hopper's funnel): those the run finds as particles go there."""
+        from pyhost.engines.fluid_case import mesh_extent
+
+        mesh = mesh_extent(self.fluid.case)
+        if mesh is None:
+            return
+        lo, hi, periodic = self.loop.dem.box()
+        tol = 1e-6 * float(np.max(mesh[1] - mesh[0]))
+        beyond = [f"{'xyz'[a]} {side} by {gap:.4g} m" for a in range(3) for side, gap in
+                  (("lo", mesh[0][a] - lo[a]), ("hi", hi[a] - mesh[1][a])) if gap > tol]
+        if beyond:
+            print(f"warning: the DEM's box [{', '.join(f'{v:.4g}' for v in lo)}] .. [{', '.join(f'{v:.4g}' for v in hi)}] m "
+                  f"reaches beyond the fluid's mesh ({'; '.join(beyond)}): a particle there has no gas, and the run "
+                  "stops when one goes there (exit 3)")
 
     def couple(self) -> None:
         """The fluid's force on each particle from the current fluid, then the fluid advanced
@@ -136,18 +161,22 @@ class FluidExchange(Effect):
 
     def bed_state(self, atoms) -> tuple:
         """The fluid columns of history.csv, heights taken against gravity (``upwards``): the
-        superficial inlet velocity [m/s] (NaN for a user's case, whose inlet the host does not
-        set); the pressure drop the particles cause [Pa], mean p of the lowest cell layer less
-        that of the highest, less the fluid's own hydrostatic head between them; the bed height
-        [m], twice the mean particle centre height above the box's lowest face (exact for a
-        uniform bed)."""
+        superficial inlet velocity [m/s] (a user's case: the mean speed of the gas coming in
+        through its fixed-inflow patches, ``fluid_case.inlet_speed``; NaN for a closed case or
+        an inlet condition it does not read); the pressure drop the particles cause [Pa], mean
+        p of the lowest cell layer less that of the highest, less the fluid's own hydrostatic
+        head between them; the bed height [m], twice the mean particle centre height above the
+        box's lowest face (exact for a uniform bed)."""
         loop = self.loop
         up = self.up
         h = self.fluid.cell_centres @ up
         head = self.fluid.rho * float(self.fluid.gravity() @ up) * (h.max() - h.min())
         lo, hi, _ = loop.dem.box()
         floor = float(np.sum(np.minimum(lo * up, hi * up)))
-        inlet = math.nan if loop.scene.fluid.case else float(loop.scene.fluid.inlet_at(loop.t))
+        if loop.scene.fluid.case:
+            inlet = self.inlet(loop.t) if self.inlet is not None else math.nan
+        else:
+            inlet = float(loop.scene.fluid.inlet_at(loop.t))
         return (inlet, layer_pressure_drop(self.fluid, up) + head,
                 2.0 * float(np.mean(atoms.x @ up - floor)) if len(atoms.x) else math.nan)
 

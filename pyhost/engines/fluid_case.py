@@ -593,3 +593,78 @@ def adopt_other_solver(case: str | Path) -> list[str]:
                 notes.append("fvSchemes divSchemes: " + "; ".join(f"{k} {' '.join(v)}" for k, v in added.items())
                              + " added (collheatFoam's momentum equation asks for them)")
     return notes
+
+
+def mesh_extent(case: str | Path) -> tuple[np.ndarray, np.ndarray] | None:
+    """(lo, hi) [m] of a case's mesh points (constant/polyMesh/points), None without them."""
+    path = Path(case) / "constant" / "polyMesh" / "points"
+    if not path.is_file():
+        return None
+    points = np.asarray(FoamFile(path)[None], float).reshape(-1, 3)
+    return points.min(axis=0), points.max(axis=0)
+
+
+def _face_areas(case: Path, start: int, count: int) -> np.ndarray:
+    """Area vectors [m^2] of the mesh's faces start .. start + count (outward on the boundary)."""
+    mesh = case / "constant" / "polyMesh"
+    points = np.asarray(FoamFile(mesh / "points")[None], float).reshape(-1, 3)
+    faces = FoamFile(mesh / "faces")[None][start:start + count]
+    areas = np.zeros((len(faces), 3))
+    for k, face in enumerate(faces):
+        p = points[np.asarray(face, int)]
+        areas[k] = 0.5 * np.cross(p[1:-1] - p[0], p[2:] - p[0]).sum(axis=0)
+    return areas
+
+
+def _table_at(rows, t: float) -> np.ndarray:
+    """OpenFOAM's table: linear between its rows, held beyond its first and last."""
+    times = np.array([r[0] for r in rows], float)
+    values = np.array([r[1] for r in rows], float).reshape(len(rows), -1)
+    return np.array([np.interp(t, times, values[:, i]) for i in range(values.shape[1])])
+
+
+def inlet_speed(case: str | Path, start: str = "0"):
+    """The mean speed [m/s] at which the gas of a user's case comes in through its patches of
+    fixed inflow, as a function of the time [s]: the inflow [m^3/s] over those patches' area
+    [m^2]. Read from the mesh (constant/polyMesh) and the start time's U: ``fixedValue`` with a
+    uniform value, ``uniformFixedValue`` (constant or table) and ``flowRateInletVelocity`` with a
+    constant ``volumetricFlowRate``. None where no patch of those lets gas in (a closed or a
+    periodic case) or the mesh is not written yet."""
+    case = Path(case)
+    try:
+        boundary = FoamFile(case / "constant" / "polyMesh" / "boundary")[None]
+        U = FoamFile(case / start / "U")["boundaryField"]
+    except (OSError, KeyError, ValueError):
+        return None
+    inlets = []                         # (area vectors, velocity of t, or None; flow rate or None)
+    for name, patch in boundary:
+        entry = U.get(name) if hasattr(U, "get") else None
+        kind = entry.get("type") if entry is not None else None
+        if kind == "fixedValue" and np.ndim(entry.get("value")) == 1:
+            value = np.asarray(entry["value"], float)
+            speed = lambda t, v=value: v
+        elif kind == "uniformFixedValue" and isinstance(entry.get("uniformValue"), tuple):
+            how, data = entry["uniformValue"][0], entry["uniformValue"][1]
+            if how == "constant":
+                speed = lambda t, v=np.asarray(data, float): v
+            elif how == "table":
+                speed = lambda t, rows=data: _table_at(rows, t)
+            else:
+                continue
+        elif kind == "flowRateInletVelocity" and isinstance(entry.get("volumetricFlowRate"), (int, float)):
+            inlets.append((_face_areas(case, patch["startFace"], patch["nFaces"]), None,
+                           float(entry["volumetricFlowRate"])))
+            continue
+        else:
+            continue
+        inlets.append((_face_areas(case, patch["startFace"], patch["nFaces"]), speed, None))
+
+    def at(t: float) -> float:
+        flow = area = 0.0
+        for S, speed, rate in inlets:
+            q = rate if rate is not None else float(-np.sum(S @ speed(t)))
+            if q > 0:
+                flow, area = flow + q, area + float(np.linalg.norm(S, axis=1).sum())
+        return flow / area if area > 0 else float("nan")
+
+    return at if inlets else None

@@ -487,8 +487,9 @@ def test_an_unclosed_list_in_liggghtscommands_is_named_in_that_file(tmp_path):
 
 def test_a_particle_leaving_the_fluid_mesh_is_a_failed_simulation_naming_it(tmp_path):
     """A DEM box wider than the fluid's mesh (0.04 m against 0.02 m across) and the sphere
-    thrown sideways at 5 m/s out of the mesh: exit 3 naming the particle, where it is and how fast it
-    goes, and the likely cause; it was exit 2, bad input, naming 'index 0' only."""
+    thrown sideways at 5 m/s out of the mesh: the box's reach beyond the mesh is said at the
+    start, and the run ends with exit 3 naming the particle, where it is and how fast it goes,
+    and the likely cause; it was exit 2, bad input, naming 'index 0' only."""
     cfd = cfdem_case(tmp_path, end=0.05)
     script = cfd.parent / "DEM" / "in.liggghts_run"
     script.write_text(script.read_text().replace("region          reg block 0 0.02 0 0.02 0 0.08",
@@ -496,6 +497,8 @@ def test_a_particle_leaving_the_fluid_mesh_is_a_failed_simulation_naming_it(tmp_
                       .replace("fix         integr all nve/sphere", "velocity all set 5.0 0 0\nfix         integr all nve/sphere"))
     r = run(cfd)
     assert r.returncode == 3, r.stdout[-3000:] + r.stderr[-3000:]
+    assert ("warning: the DEM's box [0, 0, 0] .. [0.04, 0.02, 0.08] m reaches beyond the fluid's mesh (x hi by 0.02 m)"
+            in r.stdout), r.stdout[-3000:]            # said at the start, before the sphere goes there
     assert re.search(r"1 particle\(s\) are outside the fluid's mesh, e.g. particle 1 at \[0\.02\d*, 0\.01, 0\.0\d+\] m "
                      r"moving at \[\d\.\d+, 0\.0, -?0\.\d+\] m/s: the DEM's walls and box do not keep the particles", r.stderr), r.stderr
     summary = json.loads((cfd / "output" / "summary.json").read_text())

@@ -77,3 +77,26 @@ def test_a_dictionary_openfoam_cannot_read_is_named_before_the_engines(tmp_path)
     with pytest.raises(SceneError, match=rf"{case} \(as the host adapts it\)/system/fvSchemes: OpenFOAM cannot read "
                                          r"it: Found \{ but expected \} file: system/fvSchemes at line \d+"):
         load_scene(case / "case.toml")
+
+
+def test_the_inlet_speed_of_a_users_case_is_read_from_its_inlets(tmp_path):
+    """MPPICFoam's injectionChannel lets its gas in through two patches at (18.7939, +-6.8404, 0)
+    m/s, each perpendicular to its face: history.csv's u_inlet is that speed, 20.0000437 m/s, to
+    1e-9 (it was NaN for every user's case); the closed column has none (NaN)."""
+    import csv
+    import math
+
+    for name, want in (("MPPICFoam_injectionChannel", math.hypot(18.7939, 6.8404)), ("MPPICFoam_column", None)):
+        case = copy(tmp_path, name)
+        toml = case / "case.toml"
+        toml.write_text(toml.read_text().replace("end = 0.004", "end = 0.001"))
+        r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(case), "--out", str(tmp_path / name)],
+                           capture_output=True, text=True, cwd=ROOT, timeout=600)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        with open(tmp_path / name / "history.csv") as f:
+            speeds = [float(row["u_inlet"]) for row in csv.DictReader(f)]
+        assert len(speeds) >= 2
+        if want is None:
+            assert all(math.isnan(u) for u in speeds)
+        else:
+            assert speeds == pytest.approx([want] * len(speeds), rel=1e-9)
