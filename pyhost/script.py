@@ -653,16 +653,17 @@ class ScriptInfo:
         return [t for t in found if t is not None]
 
     def fix_named(self, message: str) -> Command | None:
-        """The script's fix (defined now) that LIGGGHTS' error ``message`` names, by its style
-        ("requested by heat/gran": the last defined of that style) or by its id ("fix ID",
-        'ID'), so that a fix refused at a run's set-up is named at its own line, not the
-        run's; None if it names none."""
+        """The script's fix (defined now) that LIGGGHTS' error ``message`` names, by its id
+        ("fix ID", "(id ID)", 'ID') or else by its style ("requested by heat/gran": the last
+        defined of that style), so that a fix refused at a run's set-up is named at its own
+        line, not the run's; None if it names none."""
         ours = [c for c in self.fixes.values() if c.file != "(host)"]
         for c in reversed(ours):
-            if "/" in c.words[3] and re.search(rf"(?<![\w/]){re.escape(c.words[3])}(?![\w/])", message):
+            i = re.escape(c.words[1])
+            if re.search(rf"(?i:fix)\s+{i}\b|\(id\s+{i}\)|['\"]{i}['\"]", message):
                 return c
         for c in reversed(ours):
-            if re.search(rf"(?i:fix)\s+{re.escape(c.words[1])}\b|['\"]{re.escape(c.words[1])}['\"]", message):
+            if "/" in c.words[3] and re.search(rf"(?<![\w/]){re.escape(c.words[3])}(?![\w/])", message):
                 return c
         return None
 
