@@ -35,13 +35,13 @@ from plugins.heat import MODELS
 from plugins.heat.exchange import exchange_heat
 from pyhost.collisions import WALL_BASE, contact_keys
 from pyhost.contacts import find_contacts
-from pyhost.dem_input import script_dem_contacts
+from pyhost.engines.liggghts.box_input import script_dem_contacts
 from pyhost.dumps import Clock, DumpError, DumpReader, expand, local_compute, processor_parts
 from pyhost.outdir import write_atomic
 from pyhost.output import Progress, VtkSeries, naming
 from pyhost.scene import read_toml
 from pyhost.schema import Material, SceneError, Wall, build, check_types
-from pyhost.script import ScriptError
+from pyhost.engines.liggghts.script import ScriptError
 from pyhost.walls import FACES
 
 TEMPERATURES = ("own", "dumps")
@@ -108,7 +108,7 @@ def run_output(out: Path) -> str | None:
 class ScriptDem:
     """The DEM values the script that wrote the dumps sets (``fix ... property/global``, plain
     numbers; ``pyhost.dumps.Script.globals``), behind the part of the engine's interface that
-    ``pyhost.dem_input.script_dem_contacts`` reads: post's DEM contact of each material comes
+    ``pyhost.engines.liggghts.box_input.script_dem_contacts`` reads: post's DEM contact of each material comes
     from the script as a run's comes from the engine, and a [materials.NAME.dem] table must
     agree with it. ``unread``: the values given as variables, which post cannot evaluate."""
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from bench_host import heat_by_size
 from pyhost.dem import SceneDem  # the old code (a8d075d), run with PYTHONPATH at it
-from pyhost.dem_input import place_particles
+from pyhost.engines.liggghts.box_input import place_particles
 from pyhost.loop import Coupling
 
 

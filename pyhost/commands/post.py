@@ -36,7 +36,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
-    from pyhost.dumps import parse_compute, read_script
+    from pyhost.engines.liggghts.computes import parse_compute
+    from pyhost.engines.liggghts.dump_script import read_script
     from pyhost.post import Post, load_post_scene
 
     if args.var and not args.script:

@@ -1,6 +1,6 @@
 """The DEM of a scene on the LIGGGHTS bridge (``pyhost.engines.liggghts``): a LIGGGHTS script run
 command by command, either the user's own (``[dem] script``) or the box world the host
-generates from the scene (``pyhost.dem_input``). Both go through the same class.
+generates from the scene (``pyhost.engines.liggghts.box_input``). Both go through the same class.
 
 What the coupling loop gets from it, each in LIGGGHTS' local order and valid until the next
 ``run``: ``atoms()`` (ids, positions, velocities, radii, masses, types and the writable
@@ -29,7 +29,7 @@ from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
 from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_snapshot, local_values, put_by_id, set_random_states, write_local)
-from pyhost.script import Command, ScriptError, ScriptInfo, output_files
+from pyhost.engines.liggghts.script import Command, ScriptError, ScriptInfo, output_files
 
 FLUID_FIX = "collheat_fluid"
 HEAT_GRAN_WINDOW = 200

@@ -19,7 +19,7 @@ class DemEngine(Protocol):
     """A DEM engine as the host drives it."""
 
     # -- state -------------------------------------------------------------------------
-    info: object                 # what the script declared so far (pyhost.script.ScriptInfo): walls, heat/gran, computes
+    info: object                 # what the script declared so far (pyhost.engines.liggghts.script.ScriptInfo): walls, heat/gran, computes
     events: object | None        # the contact event recorder (pyhost.engines.events), None: no contacts asked for
     link: object | None          # the other MPI ranks (pyhost.engines.ranks.Link), None when serial
 

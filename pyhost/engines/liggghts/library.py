@@ -42,7 +42,7 @@ from pyhost.walls import primitive_overlap
 LIB = "libliggghts.so.3"
 _ISOLATED = "OMPI_MCA_ess_singleton_isolated"
 _disarm_registered = False
-HELPER = Path(__file__).resolve().parents[2] / ".setup" / "lib" / "libcollheat_liggghts.so"
+HELPER = Path(__file__).resolve().parents[3] / ".setup" / "lib" / "libcollheat_liggghts.so"
 
 _c = ctypes
 _vp, _cp, _int = _c.c_void_p, _c.c_char_p, _c.c_int

@@ -185,7 +185,7 @@ def script_dem_contacts(scene, dem) -> list:
     import dataclasses
 
     from pyhost.schema import DemContact
-    from pyhost.script import ScriptError
+    from pyhost.engines.liggghts.script import ScriptError
 
     wall_of = {}
     for w in scene.walls:
