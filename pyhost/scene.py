@@ -189,15 +189,7 @@ def load_scene(path) -> Scene:
         _script_keys(dem, path, file)
     check_raw(data, file)
     effects = build(Effects, data.get("effects", {}), "effects", file)
-    if not isinstance(data["materials"], dict) or not data["materials"]:
-        raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
-    materials = {name: build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
-    for name, m in materials.items():
-        if m.b2 <= m.b1:
-            raise SceneError(f"{file}: materials.{name}.b2: must exceed b1 ({m.b1}), got {m.b2}")
-    if not isinstance(data.get("walls", []), list):
-        raise SceneError(f"{file}: walls: must be [[walls]] tables")
-    walls = [build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+    materials, walls = materials_and_walls(data, file)
     if scripted:
         particles, domain = [], None
         _types(materials, walls, file)
@@ -207,10 +199,7 @@ def load_scene(path) -> Scene:
                 raise SceneError(f"{file}: materials.{name}.dem: missing (the DEM's softened contact; a box scene "
                                  "has no script to read it from)")
         particles, domain = _box_world(data, materials, walls, file)
-    for k, item in enumerate(walls):
-        if item.material not in materials:
-            raise SceneError(f"{file}: walls[{k}].material: unknown material {item.material!r}; "
-                             f"known: {', '.join(materials)}")
+    check_wall_materials(walls, materials, file)
     time = build(Time, data.get("time", {}), "time", file)
     if not scripted:
         for key in ("dem_step", "end"):
@@ -241,6 +230,28 @@ def load_scene(path) -> Scene:
     scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem, conduction)
     check_scene(scene)
     return scene
+
+
+def materials_and_walls(data: dict, file: str) -> tuple[dict, list]:
+    """The ``[materials.NAME]`` tables (name -> Material) and ``[[walls]]`` (Wall) of a scene's
+    data: a run's scene and post's read them alike."""
+    if not isinstance(data.get("materials"), dict) or not data["materials"]:
+        raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
+    materials = {name: build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
+    for name, m in materials.items():
+        if m.b2 <= m.b1:
+            raise SceneError(f"{file}: materials.{name}.b2: must exceed b1 ({m.b1}), got {m.b2}")
+    if not isinstance(data.get("walls", []), list):
+        raise SceneError(f"{file}: walls: must be [[walls]] tables")
+    return materials, [build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+
+
+def check_wall_materials(walls: list, materials: dict, file: str) -> None:
+    """Each wall's material is one of the scene's."""
+    for k, item in enumerate(walls):
+        if item.material not in materials:
+            raise SceneError(f"{file}: walls[{k}].material: unknown material {item.material!r}; "
+                             f"known: {', '.join(materials)}")
 
 
 def _conduction(effects, conduction, fluid, file):

@@ -10,7 +10,8 @@ What is left out of the comparison, because it is wall-clock time or says where 
   ``finished``, ``host``, ``version``, any key ending in ``_wall_s`` or ``_seconds``, and
   every string with the output folder's path in it, that path replaced by ``OUT``;
 - history.csv: the columns ``wall_time``, ``wall_s``, ``elapsed_s``;
-- log files (``*.log``, ``log.*``): LIGGGHTS' and the host's logs carry timings.
+- log files (``*.log``, ``log.*``): LIGGGHTS' and the host's logs carry timings;
+- gzip headers (the time a ``.gz`` was written): a ``.gz`` is compared by its contents.
 Everything else (collision logs, VTK files, pictures, scene.json, checkpoints) is compared as bytes.
 The folder is ``out/same_outputs/`` (``ref/`` and ``now/``; the pour's dumps in ``pour/``), outside git;
 $SAME_OUTPUTS_DIR moves it (references taken by a pristine checkout of the commit before).
@@ -97,6 +98,7 @@ def run_all(into: Path, only=None) -> dict:
         r = subprocess.run([str(PYTHON), "-m", "pyhost", "run", str(ROOT / "cases" / case), "--test", "--out", str(out)],
                            cwd=ROOT, capture_output=True, text=True, timeout=1800)
         status[case] = (r.returncode, r.stderr.strip().splitlines()[-1:] if r.returncode else [])
+        (out / "root").write_text(str(ROOT))
         print(f"{case}: exit {r.returncode}", flush=True)
     p = pour()
     for name, args in post_jobs(p).items():
@@ -107,6 +109,7 @@ def run_all(into: Path, only=None) -> dict:
         r = subprocess.run([str(PYTHON), "-m", "pyhost", "post", *map(str, args), "--out", str(out)], cwd=ROOT,
                            capture_output=True, text=True, timeout=1800)
         status[name] = (r.returncode, r.stderr.strip().replace(str(out), "OUT").splitlines())
+        (out / "root").write_text(str(ROOT))
         print(f"{name}: exit {r.returncode}", flush=True)
     return status
 
@@ -126,12 +129,15 @@ def comparable(path: Path, top: Path, root: str) -> bytes | None:
     name = path.name
     if name.endswith(".log") or name.startswith("log."):
         return None
-    data = path.read_bytes().replace(str(top).encode(), b"OUT").replace(str(HERE).encode(), b"HERE")
+    data = path.read_bytes()
+    if name.endswith(".gz"):
+        data = gzip.decompress(data)        # (gzip's header holds the time it was written)
+    data = data.replace(str(top).encode(), b"OUT").replace(str(HERE).encode(), b"HERE")
     data = data.replace(root.encode(), b"ROOT")
     if name == "summary.json":
         return json.dumps(scrub_json(json.loads(data)), indent=1, sort_keys=True).encode()
     if name in ("history.csv", "history.csv.gz"):
-        text = gzip.decompress(data).decode() if name.endswith(".gz") else data.decode()
+        text = data.decode()
         rows = list(csv.reader(io.StringIO(text)))
         if rows:
             keep = [k for k, c in enumerate(rows[0]) if c not in CLOCK_COLUMNS]
@@ -140,7 +146,7 @@ def comparable(path: Path, top: Path, root: str) -> bytes | None:
 
 
 def root_of(folder: Path) -> str:
-    """The checkout a folder's outputs were made from (``root``, written with them)."""
+    """The checkout a job's outputs were made from (its ``root``, written with them)."""
     return (folder / "root").read_text().strip() if (folder / "root").exists() else str(ROOT)
 
 
@@ -154,7 +160,7 @@ def compare(ref: Path, now: Path) -> list:
         if not a.exists() or not b.exists():
             problems.append(f"{rel}: only in {'now' if b.exists() else 'ref'}")
             continue
-        x, y = comparable(a, top_a, root_of(ref)), comparable(b, top_b, root_of(now))
+        x, y = comparable(a, top_a, root_of(top_a)), comparable(b, top_b, root_of(top_b))
         if x != y:
             problems.append(f"{rel}: differs")
     return problems
@@ -173,7 +179,6 @@ def main() -> int:
         old = json.loads(stat_file.read_text()) if stat_file.exists() else {}
         stat_file.write_text(json.dumps(old | status, indent=1, sort_keys=True).replace(str(HERE), "HERE")
                              .replace(str(ROOT), "ROOT"))
-        (target / "root").write_text(str(ROOT))
     if a.save:
         return 0
     problems = compare(HERE / "ref", HERE / "now")

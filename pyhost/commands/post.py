@@ -8,6 +8,7 @@ from pathlib import Path
 
 from plugins.heat import MODELS
 
+HEAT_PATHS = ("fast", "exact")          # (pyhost.schema.Effects.heat_path)
 HELP = "collision heat of a finished LIGGGHTS run from its dump files (models A, B, C)"
 
 
@@ -26,6 +27,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--compute", action="append", default=[], metavar="'ID STYLE KEYWORDS'",
                    help="a contact compute's keywords when there is no script, e.g. 'cp pair/gran/local pos vel id'")
     p.add_argument("--model", choices=(*MODELS, "all"), default="all", help="contact heat model")
+    p.add_argument("--heat-path", choices=HEAT_PATHS, default="fast",
+                   help="the plugin's evaluation path, as a run's effects.heat_path (fast: tables; exact: the ODE)")
     p.add_argument("--out", type=Path, default=Path("collheat-post"), help="output folder")
     p.add_argument("--dt", type=float, help="DEM time step [s] (default: the script's timestep)")
     p.add_argument("--skip-bad-frames", action="store_true", help="warn about a bad frame, skip it and go on")
@@ -49,7 +52,7 @@ def run(args) -> int:
         raise ValueError(f"--dt: must be > 0, got {args.dt}")
     post = Post(args.dumps, scene, args.out, contacts=args.contacts, script=script, computes=computes,
                 models=tuple(MODELS) if args.model == "all" else (args.model,), dt=args.dt,
-                skip_bad_frames=args.skip_bad_frames, temperatures=args.temperatures)
+                skip_bad_frames=args.skip_bad_frames, temperatures=args.temperatures, heat_path=args.heat_path)
     summary = post.run()
     for w in summary["warnings"]:
         print("warning:", w)

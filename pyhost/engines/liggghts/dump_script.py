@@ -9,10 +9,12 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
 from pyhost.dumps import Clock, _is_number
+from pyhost.engines.liggghts.box_input import script_dem_contacts
 from pyhost.engines.liggghts.computes import LOCAL_STYLES, parse_compute
 from pyhost.engines.liggghts.script import Command, ScriptError, ScriptInfo, script_commands
 from pyhost.walls import PRIMITIVES
@@ -269,3 +271,50 @@ def read_script(path, variables: dict | None = None) -> Script:
     temperature_sets = [((count if clock else step), where, cmd) for (count, step), where, cmd in temperature_sets]
     return Script(timestep, computes, tuple(walls), tuple(warnings), box, tuple(heat_gran), primitives, globals_,
                   wall_types, tuple(temperature_sets), clock)
+
+
+class ScriptDem:
+    """The DEM values the script that wrote the dumps sets (``fix ... property/global``, plain
+    numbers; ``Script.globals``), behind the part of the engine's interface that
+    ``pyhost.engines.liggghts.box_input.script_dem_contacts`` reads: post's DEM contact of each material comes
+    from the script as a run's comes from the engine, and a [materials.NAME.dem] table must
+    agree with it. ``unread``: the values given as variables, which post cannot evaluate."""
+
+    def __init__(self, script: Script):
+        numbers = {}
+        self.unread = {}
+        for prop, (where, words) in script.globals.items():
+            try:
+                numbers[prop] = (where, words[0], [float(x) for x in words[1:]])
+            except ValueError:
+                self.unread[prop] = where
+        self.values = numbers
+        self.info = SimpleNamespace(globals=numbers, wall_type=script.wall_types.get)
+
+    def _value(self, prop, k):
+        where, style, v = self.values[prop]
+        try:
+            return v[k]
+        except IndexError:
+            raise ScriptError(f"{where}: property/global {prop} {style}: too few values for the dumps' atom types") \
+                from None
+
+    def type_values(self, prop, types) -> np.ndarray:
+        return np.array([self._value(prop, int(t) - 1) for t in types])
+
+    def type_pair_value(self, prop, a, b) -> float:
+        n = int(self.values[prop][2][0]) if self.values[prop][2] else 0
+        return self._value(prop, 1 + (a - 1) * n + (b - 1))
+
+
+def script_dem_contacts_of(scene, script: Script) -> list:
+    """The scene's materials, each with the DEM contact the script that wrote the dumps sets for
+    its atom types (``box_input.script_dem_contacts`` on ``ScriptDem``; checked against a given
+    dem table), the values given as variables named where one is missing."""
+    dem = ScriptDem(script)
+    try:
+        return script_dem_contacts(scene, dem)
+    except ScriptError as exc:
+        unread = "; ".join(f"{where}: {prop}" for prop, where in dem.unread.items())
+        raise ScriptError(f"{exc}" + (f" (post reads plain numbers; given as variables: {unread})" if unread
+                                       else "")) from None
