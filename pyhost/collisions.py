@@ -74,12 +74,18 @@ def minimum_image(d, size, periodic):
     return d - np.where(periodic, size * np.round(d / size), 0.0)
 
 
-def material_of(type_material, types):
+def material_of(type_material, types, where: str | None = None):
     """Material index of LIGGGHTS atom types (``type_material``: index = type, -1 none); -1
-    for a type beyond the table."""
+    for a type beyond the table, or with ``where`` (the scene file) an error naming the types."""
     table = np.asarray(type_material)
     types = np.asarray(types)
-    return np.where(types < len(table), table[np.minimum(types, len(table) - 1)], -1)
+    mat = np.where(types < len(table), table[np.minimum(types, len(table) - 1)], -1)
+    if where is not None and (mat < 0).any():
+        from pyhost.engines.liggghts.script import ScriptError
+        bad = sorted(set(types[mat < 0].tolist()))
+        raise ScriptError(f"{where}: atom type(s) {bad} have no material: name them in a "
+                          "[materials.NAME] types = [...] list")
+    return mat
 
 
 @dataclass(frozen=True)

@@ -527,12 +527,6 @@ class Liggghts:
         hi = np.array([get(f"box{a}hi") for a in "xyz"])
         return lo, hi
 
-    def radii_of(self, ids) -> np.ndarray:
-        """Radii [m] of the atoms with these ids (any shape)."""
-        lookup = np.zeros(int(self.atom("id").max(initial=0)) + 1)
-        lookup[self.atom("id")] = self.atom("radius")
-        return lookup[np.asarray(ids)]
-
     def atom(self, name: str) -> np.ndarray:
         """Zero-copy view of a per-atom array of the local atoms, in LIGGGHTS' local order:
         x, v, f, omega (n, 3); radius, rmass, id, type (n,); ``release_step`` (n,): the step at
