@@ -16,7 +16,8 @@ import numpy as np
 from pyhost.dumps import Clock, _is_number
 from pyhost.engines.liggghts.box_input import script_dem_contacts
 from pyhost.engines.liggghts.computes import LOCAL_STYLES, parse_compute
-from pyhost.engines.liggghts.script import Command, ScriptError, ScriptInfo, script_commands
+from pyhost.engines.liggghts.script import (Command, ScriptError, ScriptInfo, script_commands, sets_temperature,
+                                            step_after)
 from pyhost.walls import PRIMITIVES
 
 
@@ -215,56 +216,38 @@ def read_script(path, variables: dict | None = None) -> Script:
                             + (f"; not defined: {', '.join(undefined)}: give --var NAME VALUE as on LIGGGHTS' "
                                "command line" if undefined else "")
                             + "): its time step, box and variables are unknown; give --dt")
-    timestep, computes, walls = None, {}, []
-    heat_gran, primitives = [], {}
-    globals_, info = {}, ScriptInfo()      # info: the walls and their atom types, as a run learns them
-    step, temperature_sets, ran = 0, [], False    # the step reached (None: unknown, a $variable); any run yet
+    info = ScriptInfo()          # the script's commands read as a run reads them, with their substitutions
+    timestep, step, temperature_sets, ran = None, 0, [], False   # the step reached (None: unknown); any run yet
     runs, count, t = [], 0, 0.0     # the clock's runs so far, the steps counted through them, the time [s]
     for number, line in commands:
-        line = substituted.get(number, line)
-        words = line.split()
-        where = f"{where_of[number]}: "
+        cmd = Command(substituted.get(number, line), read[number].file, read[number].line)
         try:
-            info.learn(Command(line, read[number].file, read[number].line))
+            info.learn(cmd)
         except (ScriptError, ValueError):
             pass                        # a wall the run would refuse: post places none
-        if words[0] == "timestep" and len(words) > 1:
-            try:
-                timestep = float(words[1])
-            except ValueError:
-                timestep = dt
-        elif words[0] == "fix" and len(words) > 3 and words[3] == "heat/gran":
-            heat_gran.append(words[1])
-        elif words[0] == "fix" and len(words) > 5 and words[3] == "property/global":
-            globals_[words[4]] = (where.rstrip(": "), words[5:])
-        elif words[0] == "fix" and len(words) > 5 and words[3] == "wall/gran" and "primitive" in words:
-            kind = next((w for w in words if w in PRIMITIVES), None)
-            numbers = words[words.index(kind) + 1:][:PRIMITIVES[kind]] if kind else []
-            try:
-                if kind and len(numbers) == PRIMITIVES[kind]:
-                    primitives[words[1]] = (kind, tuple(float(w) for w in numbers))
-            except ValueError:
-                pass                    # a $variable: post cannot place that wall
-        elif words[0] == "compute" and len(words) > 3 and words[3] in LOCAL_STYLES:
-            c = parse_compute(line, where)
-            computes[c.id] = c
-        elif words[0] == "fix" and len(words) > 3 and words[3] == "wall/gran" and "mesh" in words:
-            walls.append(words[1])
-        elif words[0] in ("run", "reset_timestep", "read_restart"):
-            n = int(words[1]) if len(words) > 1 and words[1].isdigit() and words[0] != "read_restart" else None
-            first = step
-            step = (None if n is None else n if words[0] == "reset_timestep" or "upto" in words[2:]
-                    else None if step is None else step + n)
-            if words[0] == "run" and runs is not None:
-                if first is None or step is None or timestep is None:
-                    runs = None         # (a read_restart's step, a run of $variable steps: no clock)
-                elif step > first:
-                    runs.append((first, step, timestep, t))
-                    count, t = count + step - first, t + (step - first) * timestep
-            ran = ran or words[0] == "run"
-        elif (words[0] == "set" and ran and "property/atom" in words[:-2]
-              and words[words.index("property/atom") + 1] == "Temp"):     # (before any run: the first frame's)
-            temperature_sets.append(((count, step), where.rstrip(": "), " ".join(words)))
+        if cmd.name == "timestep" and info.timestep is not None:
+            timestep = float(info.timestep) if _is_number([info.timestep]) else dt
+        first, step = step, step_after(cmd, step)
+        if cmd.name == "run" and runs is not None:
+            if first is None or step is None or timestep is None:
+                runs = None             # (a read_restart's step, a run of $variable steps: no clock)
+            elif step > first:
+                runs.append((first, step, timestep, t))
+                count, t = count + step - first, t + (step - first) * timestep
+        ran = ran or cmd.name == "run"
+        if ran and sets_temperature(cmd):    # (before any run: the first frame's)
+            temperature_sets.append(((count, step), where_of[number], " ".join(cmd.text.split())))
+    where = lambda c: f"{c.file}: line {c.line}"
+    computes = {}
+    for c in info.computes.values():
+        if len(c.text.split()) > 3 and c.text.split()[3] in LOCAL_STYLES:
+            computes[c.words[1]] = parse_compute(c.text, f"{where(c)}: ")
+    globals_ = {name: (where(c), c.text.split()[5:]) for name, c in info.global_values.items()}
+    primitives = {fix: w.primitive for fix, w in info.walls_defined
+                  if w.primitive is not None and w.primitive[1] is not None
+                  and len(w.primitive[1]) == PRIMITIVES[w.primitive[0]]}
+    walls = [fix for fix, w in info.walls_defined if w.meshes]
+    heat_gran = info.conductions
     wall_types = {fix: info.wall_type(fix) for fix in info.walls if info.wall_type(fix) is not None}
     clock = Clock(tuple(runs)) if runs else None
     # each set at its step counted through the runs; without a clock, at its step (as a steady clock counts)
