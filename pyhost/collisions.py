@@ -18,17 +18,22 @@ is outside the contact models' range out (the plugin's ``plugins.heat.batch``). 
 - Begun contacts. The run's recorder sees each begin inside LIGGGHTS; post sees a contact
   begun where it first appears in a list of contacts (``FirstAppearances``); ``ended_later``:
   which contacts ended before the host looked.
+- Impact speeds. The run's recorder takes each at first touch; from dumps, a contact's
+  approach speed at its first appearance is carried back to touch with the DEM's own contact
+  law (``carried_back``), whose shortest collision bounds what dumps can resolve
+  (``shortest_collision``).
 - Heat. ``collide``: the batch's heat moved in its order between the bodies' temperatures
   (``plugins.heat.batch.move_heat``); ``conductances``: one model's heat per kelvin over a
   batch, for post, which moves it while it replays the dumps.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from plugins.heat.batch import evaluate_flagged, move_heat
+from plugins.dem.hertz import DemHertz, hertz_collision_time, impact_speeds, reduced
+from plugins.heat.batch import dem_pair, evaluate_flagged, move_heat
 from plugins.heat.exchange import WALL_BASE
 
 
@@ -172,3 +177,64 @@ class FirstAppearances:
         fresh = ~np.isin(keys, self.previous)
         self.previous = keys
         return fresh
+
+
+def dem_laws(bodies: Bodies, p: Partners, names: list, where) -> dict:
+    """The DEM's contact law of each pair of materials that collide: (a, b) -> (Y* [Pa],
+    ``plugins.dem.hertz.DemHertz``); ValueError naming a material without its DEM values
+    (``names``: the materials' names in ``where``, the scene file)."""
+    mats, laws = bodies.materials, {}
+    for a, b in set(zip(p.mat_i.tolist(), p.mat_j.tolist())):
+        for k in (a, b):
+            if mats[k].dem is None:
+                raise ValueError(f"{where}: materials.{names[k]}.dem: post recovers impact speeds with the DEM's "
+                                 "contact law: give the table (youngs_modulus, restitution, poisson_ratio), or "
+                                 "--script with the script's values")
+        dem = dem_pair(mats[a], mats[b])
+        laws[a, b] = (dem.Ystar, DemHertz(dem.Ystar, dem.restitution))
+    return laws
+
+
+def carried_back(bodies: Bodies, p: Partners, approach, delta, window, names: list, where) -> np.ndarray:
+    """Impact speeds [m/s] of contacts first seen with overlap ``delta`` [m] at approach speed
+    ``approach`` [m/s], up to ``window`` [s] after they began: carried back to touch with the
+    DEM's contact law (``plugins.dem.hertz.impact_speeds``)."""
+    R, m = reduced(p.R_i, p.R_j, p.m_i, p.m_j)
+    laws = dem_laws(bodies, p, names, where)
+    return impact_speeds(approach, lambda a, b: laws[a, b][1], p.mat_i, p.mat_j, delta, approach, R, m, window,
+                         mask=delta > 0)
+
+
+def shortest_collision(bodies: Bodies, p: Partners, v0, names: list, where) -> tuple[float, float]:
+    """The DEM's shortest Hertz collision time [s] among these collisions at the fastest impact
+    seen (1 m/s if none), and that speed [m/s]."""
+    R, m = reduced(p.R_i, p.R_j, p.m_i, p.m_j)
+    mi, mj = p.mat_i, p.mat_j
+    v = float(v0.max()) if np.any(v0 > 0) else 1.0
+    return min(hertz_collision_time(Y, R[(mi == a) & (mj == b)].min(), m[(mi == a) & (mj == b)].min(), v)
+               for (a, b), (Y, _) in dem_laws(bodies, p, names, where).items()), v
+
+
+@dataclass
+class Found:
+    """Collisions found (post: first appearances in dumps): each one's step, particle ``i``,
+    partner ``j``, overlap ``delta`` [m] and approach speed [m/s] when first seen, and the
+    ``window`` [s] since the look before; lists of arrays until ``array()`` gives them in the
+    order of their steps."""
+
+    columns = ("step", "i", "j", "delta", "approach", "window")
+    parts: dict = field(default_factory=lambda: {c: [] for c in Found.columns})
+
+    def add(self, **arrays) -> None:
+        for c in self.columns:
+            self.parts[c].append(np.broadcast_to(arrays[c], np.shape(arrays["i"])).astype(float))
+
+    def count(self) -> int:
+        return sum(len(a) for a in self.parts["i"])
+
+    def array(self) -> dict:
+        out = {c: np.concatenate(v) if v else np.zeros(0) for c, v in self.parts.items()}
+        order = np.argsort(out["step"], kind="stable")
+        out = {c: a[order] for c, a in out.items()}
+        out["i"], out["j"] = out["i"].astype(np.int64), out["j"].astype(np.int64)
+        return out

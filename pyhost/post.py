@@ -23,78 +23,27 @@ from __future__ import annotations
 import csv
 import gzip
 import json
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from plugins.dem.hertz import DemHertz, hertz_collision_time, impact_speeds, reduced
-from plugins.heat.batch import dem_pair
 from plugins.heat import MODELS
 from plugins.heat.exchange import exchange_heat
-from pyhost.collisions import (Bodies, FirstAppearances, conductances, contact_keys, log_wall, material_of,
-                               sphere_mass, wall_code, wall_of)
+from pyhost.collisions import (Bodies, FirstAppearances, Found, carried_back, conductances, contact_keys, log_wall,
+                               material_of, shortest_collision, sphere_mass, wall_code, wall_of)
 from pyhost.contacts import find_contacts
 from pyhost.dumps import Clock, DumpError, DumpReader
 from pyhost.engines.liggghts.dump_contacts import ContactDumps
 from pyhost.engines.liggghts.dump_script import script_dem_contacts_of
-from pyhost.outdir import write_atomic
+from pyhost.outdir import run_output, write_atomic
 from pyhost.output import Progress, VtkSeries, naming
-from pyhost.scene import check_wall_materials, materials_and_walls, read_toml
-from pyhost.schema import SceneError, check_types
-from pyhost.walls import FACES
+from pyhost.scene import PostScene
 
 TEMPERATURES = ("own", "dumps")
 """How post's particle temperatures evolve: ``own``, from each particle's first temperature by
 the models' collision heat (and the script's Temp sets); ``dumps``, taken from the dumps at every
 frame (the run's own conduction and sources), the collisions until the next frame moving heat
 from there: what the models' collisions would move in the run's own temperature field."""
-
-
-@dataclass(frozen=True)
-class PostScene:
-    path: Path
-    materials: dict                 # name -> Material (real and DEM values, types, temperature)
-    types: dict                     # LIGGGHTS atom type -> material index
-    temperature: dict               # initial temperature per atom type [K]; 0: from the dumps
-    walls: list                     # pyhost.scene.Wall
-
-
-def load_post_scene(path) -> PostScene:
-    """The ``[materials.NAME]`` (with ``types`` and an optional ``temperature``) and ``[[walls]]``
-    (``fix`` or ``plane``, ``material``, ``temperature``) of a scene file, read as a run reads
-    them (``pyhost.scene``); its other sections belong to runs and are not read here, so a
-    case.toml serves both."""
-    path, file = Path(path), str(path)
-    materials, walls = materials_and_walls(read_toml(path), file)
-    names = list(materials)
-    types = {t: names.index(name) for t, name in check_types(materials, file).items()}
-    if not types:
-        raise SceneError(f"{file}: materials: no material names its LIGGGHTS atom types (types = [1, 2])")
-    check_wall_materials(walls, materials, file)
-    for k, wall in enumerate(walls):
-        if bool(wall.fix) == bool(wall.plane):
-            raise SceneError(f"{file}: walls[{k}]: give either fix (the id of a LIGGGHTS wall) or plane "
-                             f"({', '.join(FACES)})")
-    return PostScene(path, materials, types, {t: materials[names[k]].temperature_of(t) for t, k in types.items()},
-                     walls)
-
-
-def run_output(out: Path) -> str | None:
-    """What marks ``out`` as a run's output folder (``pyhost run``), which post must not write
-    into: its scene.json, a file only a run writes (history.csv, collisions.csv, checkpoint,
-    ...: a run of an older version or stopped on a full disk has no scene.json), or a
-    summary.json that is not post's (a run's has a status, post's its frames); None if
-    nothing does."""
-    from pyhost.outdir import RUN_FILES
-    for name in RUN_FILES:
-        if name not in ("summary.json", "vtk") and (out / name).exists():
-            return name
-    try:
-        summary = json.loads((out / "summary.json").read_text())
-    except (OSError, ValueError):
-        return None
-    return "summary.json with a status" if not isinstance(summary, dict) or "frames" not in summary else None
 
 
 class Particles:
@@ -114,28 +63,6 @@ class Particles:
         self.type[ids], self.radius[ids] = types, radius
         if temperature is not None:
             self.T0[ids] = np.where(np.isnan(self.T0[ids]), temperature, self.T0[ids])
-
-
-@dataclass
-class Found:
-    """Collisions found (first appearances), as lists of arrays until ``array()``."""
-
-    columns = ("step", "i", "j", "delta", "approach", "window")
-    parts: dict = field(default_factory=lambda: {c: [] for c in Found.columns})
-
-    def add(self, **arrays) -> None:
-        for c in self.columns:
-            self.parts[c].append(np.broadcast_to(arrays[c], np.shape(arrays["i"])).astype(float))
-
-    def count(self) -> int:
-        return sum(len(a) for a in self.parts["i"])
-
-    def array(self) -> dict:
-        out = {c: np.concatenate(v) if v else np.zeros(0) for c, v in self.parts.items()}
-        order = np.argsort(out["step"], kind="stable")
-        out = {c: a[order] for c, a in out.items()}
-        out["i"], out["j"] = out["i"].astype(np.int64), out["j"].astype(np.int64)
-        return out
 
 
 ATOMS_REQUIRED = ("id", "type", "position", "velocity", "radius")
@@ -315,38 +242,18 @@ class Post(ContactDumps):
         return bodies, bodies.partners(j, material_of(type_material, t[i]), R[i], material_of(type_material, t[jj]),
                                        R[jj])
 
-    def dem_laws(self, mi, mj):
-        mats = self.materials
-        laws = {}
-        for a, b in set(zip(mi.tolist(), mj.tolist())):
-            for k in (a, b):
-                if mats[k].dem is None:
-                    raise ValueError(f"{self.scene.path}: materials.{list(self.scene.materials)[k]}.dem: post "
-                                     f"recovers impact speeds with the DEM's contact law: give the table "
-                                     f"(youngs_modulus, restitution, poisson_ratio), or --script with the script's "
-                                     f"fix property/global")
-            dem = dem_pair(mats[a], mats[b])
-            laws[a, b] = (dem.Ystar, DemHertz(dem.Ystar, dem.restitution))
-        return laws
-
     def impact_speeds(self, c) -> np.ndarray:
-        _, p = self.partners(c["i"], c["j"])
-        mi, mj = p.mat_i, p.mat_j
-        R, m = reduced(p.R_i, p.R_j, p.m_i, p.m_j)
-        laws = self.dem_laws(mi, mj)
-        v0 = impact_speeds(c["approach"], lambda a, b: laws[a, b][1], mi, mj, c["delta"], c["approach"], R, m,
-                           c["window"], mask=c["delta"] > 0)
-        self.shortest_collision(mi, mj, R, m, v0)
+        """Each collision's impact speed [m/s], its approach speed carried back to touch."""
+        bodies, p = self.partners(c["i"], c["j"])
+        names = list(self.scene.materials)
+        v0 = carried_back(bodies, p, c["approach"], c["delta"], c["window"], names, self.scene.path)
+        if len(v0) and self.interval is not None:
+            self.shortest_collision(*shortest_collision(bodies, p, v0, names, self.scene.path))
         return v0
 
-    def shortest_collision(self, mi, mj, R, m, v0) -> None:
-        """The DEM's shortest Hertz collision time among the collisions found, at the fastest
-        impact seen (1 m/s if none), against the dump interval."""
-        if not len(v0) or self.interval is None:
-            return
-        v = float(v0.max()) if np.any(v0 > 0) else 1.0
-        t_c = min(hertz_collision_time(Y, R[(mi == a) & (mj == b)].min(), m[(mi == a) & (mj == b)].min(), v)
-                  for (a, b), (Y, _) in self.dem_laws(mi, mj).items())
+    def shortest_collision(self, t_c: float, v: float) -> None:
+        """The DEM's shortest collision time t_c [s] among the collisions found (at the fastest
+        impact v [m/s]) against the dump interval."""
         interval, steps = self.interval
         self.summary.update(dump_interval_s=interval, shortest_collision_s=t_c)
         if interval > t_c:

@@ -54,6 +54,7 @@ from plugins.heat import MODELS
 from pyhost.schema import (Conduction, Dem, Domain, Effects, Fluid, Material, Output, Particles,  # noqa: F401
                            check_types, Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
 from pyhost.validate import check_scene
+from pyhost.walls import FACES
 
 
 def _box(values, key, file, n=6):
@@ -252,6 +253,37 @@ def check_wall_materials(walls: list, materials: dict, file: str) -> None:
         if item.material not in materials:
             raise SceneError(f"{file}: walls[{k}].material: unknown material {item.material!r}; "
                              f"known: {', '.join(materials)}")
+
+
+@dataclasses.dataclass(frozen=True)
+class PostScene:
+    """What ``pyhost post`` reads of a scene file (``load_post_scene``)."""
+
+    path: Path
+    materials: dict                 # name -> Material (real and DEM values, types, temperature)
+    types: dict                     # LIGGGHTS atom type -> material index
+    temperature: dict               # initial temperature per atom type [K]; 0: from the dumps
+    walls: list                     # pyhost.scene.Wall
+
+
+def load_post_scene(path) -> PostScene:
+    """The ``[materials.NAME]`` (with ``types`` and an optional ``temperature``) and ``[[walls]]``
+    (``fix`` or ``plane``, ``material``, ``temperature``) of a scene file, read as a run reads
+    them (``pyhost.scene``); its other sections belong to runs and are not read here, so a
+    case.toml serves both."""
+    path, file = Path(path), str(path)
+    materials, walls = materials_and_walls(read_toml(path), file)
+    names = list(materials)
+    types = {t: names.index(name) for t, name in check_types(materials, file).items()}
+    if not types:
+        raise SceneError(f"{file}: materials: no material names its LIGGGHTS atom types (types = [1, 2])")
+    check_wall_materials(walls, materials, file)
+    for k, wall in enumerate(walls):
+        if bool(wall.fix) == bool(wall.plane):
+            raise SceneError(f"{file}: walls[{k}]: give either fix (the id of a LIGGGHTS wall) or plane "
+                             f"({', '.join(FACES)})")
+    return PostScene(path, materials, types, {t: materials[names[k]].temperature_of(t) for t, k in types.items()},
+                     walls)
 
 
 def _conduction(effects, conduction, fluid, file):

@@ -41,7 +41,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     from pyhost.engines.liggghts.computes import parse_compute
     from pyhost.engines.liggghts.dump_script import read_script
-    from pyhost.post import Post, load_post_scene
+    from pyhost.post import Post
+    from pyhost.scene import load_post_scene
 
     if args.var and not args.script:
         raise ValueError("--var: give --script, the LIGGGHTS input whose variables they are")

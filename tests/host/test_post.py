@@ -11,7 +11,7 @@ import pytest
 from conftest import steel_toml
 import pyvista
 
-from pyhost.post import load_post_scene
+from pyhost.scene import load_post_scene
 from pyhost.scene import SceneError
 
 ROOT = Path(__file__).resolve().parents[2]

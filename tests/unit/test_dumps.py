@@ -253,7 +253,8 @@ def test_the_scripts_dem_values_give_each_materials_dem_contact(tmp_path):
     """post's DEM contact of each material from the script's fix property/global (per type, the
     restitution per type pair read at (t, t)); the primitive wall's material from its type; a
     value given as a variable cannot be read, and the refusal says so and where."""
-    from pyhost.post import Post, load_post_scene
+    from pyhost.post import Post
+    from pyhost.scene import load_post_scene
 
     material = ("density = 2500.0\nyoungs_modulus = 63e9\npoisson_ratio = 0.22\nyield_stress = 500e6\n"
                 "heat_capacity = 800.0\nconductivity = 1.0\n")
