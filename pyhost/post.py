@@ -35,6 +35,7 @@ from pyhost.contacts import find_contacts
 from pyhost.dumps import Clock, DumpError, DumpReader
 from pyhost.engines.liggghts.dump_contacts import ContactDumps
 from pyhost.engines.liggghts.dump_script import script_dem_contacts_of
+from pyhost.engines.liggghts.names import BOX, CONDUCTION, CONDUCTION_FIX, TEMPERATURE, WALL_CONTACTS
 from pyhost.outdir import run_output, write_atomic
 from pyhost.output import Progress, VtkSeries, naming
 from pyhost.scene import PostScene
@@ -93,9 +94,9 @@ class Post(ContactDumps):
             self.clock = Clock.steady(dt)
         self.warnings = list(script.warnings) if script else []
         if script and script.heat_gran and temperatures == "own":
-            self.warnings.append(f"the script conducts heat with fix heat/gran ({', '.join(script.heat_gran)}): post's "
+            self.warnings.append(f"the script conducts heat with {CONDUCTION_FIX} ({', '.join(script.heat_gran)}): post's "
                                  "temperatures change by its models' collision heat and the script's Temp sets only, "
-                                 "not by heat/gran's conduction through lasting contacts or its heat sources "
+                                 f"not by {CONDUCTION}'s conduction through lasting contacts or its heat sources "
                                  "(--temperatures dumps takes the dumped temperatures at every frame)")
         self.materials = self.dem_contacts(scene, script)
         if script:
@@ -167,7 +168,7 @@ class Post(ContactDumps):
                 if w.fix in primitives:
                     walls.append((k, primitives[w.fix]))
                 elif w.fix:
-                    self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps (wall/gran/local), "
+                    self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps ({WALL_CONTACTS}), "
                                          "or --script when it is a primitive wall; without them it is ignored")
         steps, last = [], None
         progress = Progress(float("inf"), self.progress_every)
@@ -203,7 +204,7 @@ class Post(ContactDumps):
         box = self.frame_box(f)
         if any(isinstance(w, str) for _, w in walls) and box is None:
             raise ValueError(f"{f.file}: a VTK dump has no box, so walls on its faces cannot be placed: give --script "
-                             "(its create_box), or use text dumps")
+                             f"(its {BOX}), or use text dumps")
         x = f.positions()
         box = box if box is not None else np.stack([x.min(0) - 1.0, x.max(0) + 1.0], axis=1)
         c = find_contacts(x, f.vector("v"), f["radius"], box.ravel(), f.periodic, [p for _, p in walls])
@@ -388,7 +389,7 @@ class Post(ContactDumps):
                 if self.temperatures == "dumps":      # the run's own temperatures from here to the next frame
                     if column is None:
                         raise DumpError(f.file, f.timestep, f.line, "--temperatures dumps: the frame has no particle "
-                                                                "temperature (f_Temp)")
+                                                                f"temperature ({TEMPERATURE})")
                     for m in self.models:
                         T[m][ids] = f[column]
                 fields = dict(id=ids, type=f["type"].astype(int), radius=f["radius"], velocity=f.vector("v"))
@@ -417,7 +418,7 @@ class Post(ContactDumps):
         said = [f"{where}: {command}" for _, where, command in temperature_sets]
         column = self.temperature_column(f)
         if before[2] is None or column is None:
-            self.warnings.append(f"{'; '.join(said)}: the dumps have no particle temperature (f_Temp), so post's "
+            self.warnings.append(f"{'; '.join(said)}: the dumps have no particle temperature ({TEMPERATURE}), so post's "
                                  "temperatures do not follow it")
             return
         ids0, T0 = before[1], before[2]
@@ -440,5 +441,5 @@ class Post(ContactDumps):
         missing = known & np.isnan(T0)
         if missing.any():
             name = list(self.scene.materials)[mat[np.flatnonzero(missing[known])[0]]]
-            raise ValueError(f"{self.scene.path}: materials.{name}.temperature: needed (the dumps hold no f_Temp)")
+            raise ValueError(f"{self.scene.path}: materials.{name}.temperature: needed (the dumps hold no {TEMPERATURE})")
         return T0

@@ -54,6 +54,7 @@ from plugins.heat import MODELS
 from pyhost.schema import (Conduction, Dem, Domain, Effects, Fluid, Material, Output, Particles,  # noqa: F401
                            check_types, Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
 from pyhost.validate import check_scene
+from pyhost.engines.liggghts.names import CONDUCTION_FIX, COUPLING_FIX, WALL_FIX
 from pyhost.walls import FACES
 
 
@@ -280,7 +281,7 @@ def load_post_scene(path) -> PostScene:
     check_wall_materials(walls, materials, file)
     for k, wall in enumerate(walls):
         if bool(wall.fix) == bool(wall.plane):
-            raise SceneError(f"{file}: walls[{k}]: give either fix (the id of a LIGGGHTS wall) or plane "
+            raise SceneError(f"{file}: walls[{k}]: give either fix, the id of a LIGGGHTS {WALL_FIX}, or plane "
                              f"({', '.join(FACES)})")
     return PostScene(path, materials, types, {t: materials[names[k]].temperature_of(t) for t, k in types.items()},
                      walls)
@@ -294,7 +295,7 @@ def _conduction(effects, conduction, fluid, file):
     if effects.contact_conduction != "none" and effects.enduring_conduction:
         raise SceneError(f"{file}: effects.contact_conduction: {effects.contact_conduction!r} and "
                          "effects.enduring_conduction both conduct through lasting contacts (the second through "
-                         "LIGGGHTS' fix heat/gran): choose one")
+                         f"LIGGGHTS' {CONDUCTION_FIX}): choose one")
     if effects.gap_conduction == "none":
         return conduction
     if conduction.gas_conductivity == 0:
@@ -452,12 +453,13 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
         if not given:
             taken[table][key] = ours
     if dem.script and "time.couple_every" not in found:       # (a file exchange: the script's interval)
-        every = _script_couple_every(path.resolve().parent / dem.script)
+        from pyhost.engines.liggghts.script import script_couple_every
+        every = script_couple_every(path.resolve().parent / dem.script)
         if every is not None:
             number, line = every
             if "couple_every" in data.get("time", {}) and time.couple_every != number:
                 raise SceneError(f"{file}: time.couple_every: {time.couple_every}, but {line} couples every "
-                                 f"{number} DEM steps (fix couple/cfd): remove time.couple_every to take the "
+                                 f"{number} DEM steps ({COUPLING_FIX}): remove time.couple_every to take the "
                                  "script's, or make them agree")
             taken["time"]["couple_every"] = number
     return tuple(dataclasses.replace(tables[k], **taken[k]) for k in ("effects", "fluid", "time"))
@@ -479,24 +481,14 @@ def _case_commands(folder: Path, file: str) -> None:
         raise SceneError(f"{file}: fluid.case: {exc}") from None
 
 
-def _script_couple_every(script: Path) -> tuple[int, str] | None:
-    """``couple_every N`` of a CFDEM script's ``fix ID GROUP couple/cfd`` (the script's own text,
-    not its includes) and where it is, or None."""
-    for k, line in enumerate(script.read_text(errors="replace").splitlines(), 1):
-        m = re.match(r"\s*fix\s+\S+\s+\S+\s+couple/cfd\b.*?\bcouple_every\s+(\d+)\b", line.split("#")[0])
-        if m:
-            return int(m.group(1)), f"{script}:{k}"
-    return None
-
-
 def _types(materials, walls, file):
     """Script scenes: each material names its atom types, no type twice (a list of temperatures
     one per type); walls name a fix."""
     check_types(materials, file)
     for k, w in enumerate(walls):
         if not w.fix or w.plane:
-            raise SceneError(f"{file}: walls[{k}]: a script scene names a LIGGGHTS wall by fix = \"ID\" "
-                             "(the id of its fix wall/gran), not by plane")
+            raise SceneError(f"{file}: walls[{k}]: a script scene names a LIGGGHTS wall by \"fix\", the id of its "
+                             f"{WALL_FIX}, not by plane")
 
 
 def _box_world(data, materials, walls, file):

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from plugins.heat import MODELS
+from pyhost.engines.liggghts.names import PAIR_CONTACTS, TEMPERATURE, WALL_CONTACTS
 
 HEAT_PATHS = ("fast", "exact")          # (pyhost.schema.Effects.heat_path)
 HELP = "collision heat of a finished LIGGGHTS run from its dump files (models A, B, C)"
@@ -18,7 +19,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scene", type=Path, required=True,
                    help="TOML with [materials.NAME] (types = [...], temperature) and [[walls]] (fix or plane)")
     p.add_argument("--contacts", nargs="+", default=[], metavar="DUMP",
-                   help="dump local files of compute pair/gran/local and wall/gran/local")
+                   help=f"dump local files of compute {PAIR_CONTACTS} and {WALL_CONTACTS}")
     p.add_argument("--script", type=Path, help="the LIGGGHTS input that wrote the dumps (timestep, computes, "
                                                "mesh wall fixes)")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
@@ -34,7 +35,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--skip-bad-frames", action="store_true", help="warn about a bad frame, skip it and go on")
     p.add_argument("--temperatures", choices=("own", "dumps"), default="own",
                    help="own: each particle from its first temperature, changed by the models' collision heat (and "
-                        "the script's Temp sets); dumps: the dumped temperature (f_Temp) at every frame, as the run's "
+                        f"the script's Temp sets); dumps: the dumped temperature ({TEMPERATURE}) at every frame, as the run's "
                         "own conduction and sources left it, the collisions until the next frame moving heat from there")
 
 

@@ -497,9 +497,14 @@ class Dem:
             raise OSError(errno.EIO, f"LIGGGHTS wrote a restart it cannot read back, a full disk? ({exc})",
                           str(path)) from None
 
-    def engine_command(self, line: str) -> None:
-        """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""
-        self._raw(line)
+    def drop_lost(self) -> None:
+        """A set-up now, on every rank, after which the particles past a fixed face of the box
+        are gone (LIGGGHTS drops them at a re-neighbouring: 'thermo_modify lost ignore')."""
+        self._raw("run 0 post no")
+
+    def write_restart(self, path) -> None:
+        """LIGGGHTS' restart file written at ``path``, on every rank."""
+        self._raw(f"write_restart {path}")
 
     def add_velocity(self, local_index, dv) -> None:
         """Add dv [m/s] to the velocity of these atoms (indices into the last ``atoms()``)."""

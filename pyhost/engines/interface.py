@@ -89,8 +89,12 @@ class DemEngine(Protocol):
         each named in the engine's errors (an engine that checks each command before running
         it may check them together first)."""
 
-    def engine_command(self, line: str) -> None:
-        """Run a command of the host's own (write_restart, ...)."""
+    def drop_lost(self) -> None:
+        """A set-up now, after which the particles past a fixed face of the box are gone (a
+        checkpoint's restart file then holds what the host's state does)."""
+
+    def write_restart(self, path) -> None:
+        """Write the engine's restart file at ``path`` (a checkpoint's)."""
 
     def check_restart(self, path) -> None:
         """The engine's restart file just written at ``path`` is whole (read back): OSError

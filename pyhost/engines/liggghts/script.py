@@ -517,6 +517,16 @@ def sets_temperature(cmd: Command) -> bool:
     return words[0] == "set" and "property/atom" in words[:-2] and words[words.index("property/atom") + 1] == "Temp"
 
 
+def script_couple_every(script: Path) -> tuple[int, str] | None:
+    """``couple_every N`` of a CFDEM script's ``fix ID GROUP couple/cfd`` (the script's own text,
+    not its includes) and where it is, or None."""
+    for k, line in enumerate(script.read_text(errors="replace").splitlines(), 1):
+        m = re.match(r"\s*fix\s+\S+\s+\S+\s+couple/cfd\b.*?\bcouple_every\s+(\d+)\b", line.split("#")[0])
+        if m:
+            return int(m.group(1)), f"{script}:{k}"
+    return None
+
+
 def output_files(cmd: Command) -> list[str]:
     """The files a command makes LIGGGHTS open without making their folder, as the script
     names them (relative to where the script runs; ``$`` variables unresolved): a fix's
