@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.collisions import WALL_BASE
+from pyhost.collisions import wall_code
 from pyhost.engines.atoms import Atoms, local_view
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
@@ -568,11 +568,11 @@ class Dem:
             self._pending = None
             self.log("the host's contact recorder (fix collheat_events) given anew after the script's walls "
                      "defined since the first run: it sums heat/gran's flux through their contacts after they add it")
-        primitive = [(fix, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items() if w.primitive is not None]
+        primitive = [(fix, int(wall_code(wall_index[fix, 0]))) for fix, w in self.info.walls.items() if w.primitive is not None]
         if not self.events.primitives(*(zip(*primitive) if primitive else ([], []))):
             raise ScriptError(f"the primitive walls {', '.join(f for f, _ in primitive)}: one is not a fix wall/gran "
                               "with a primitive wall the contact recorder can read: their collisions cannot be seen")
-        meshes = [(mesh, WALL_BASE + wall_index[fix, k]) for fix, w in self.info.walls.items()
+        meshes = [(mesh, int(wall_code(wall_index[fix, k]))) for fix, w in self.info.walls.items()
                   for k, mesh in enumerate(w.meshes or ())]
         if not self.events.meshes(*(zip(*meshes) if meshes else ([], []))):
             names = ", ".join(sorted({m for m, _ in meshes}))
@@ -593,7 +593,7 @@ class Dem:
                                ("overlap", "constant", "projection").index(mode) if mode in ("constant", "projection")
                                else 0, self.value(area) if mode == "constant" and T is not None else 0.0))
                 if T is not None:
-                    conducting.add(WALL_BASE + wall_index[fix, k])
+                    conducting.add(int(wall_code(wall_index[fix, k])))
             if not self.events.wall_conduction(meshes, params):
                 raise ScriptError(f"walls {', '.join(f for f, _ in walls)}: the contact recorder cannot follow "
                                   "heat/gran's conduction through them (an atom type out of range?)")
