@@ -1,4 +1,5 @@
-"""Behaviour unchanged? Runs the box cases (``pyhost run CASE --test``) and a few ``pyhost post``
+"""Behaviour unchanged? Runs the box cases (``pyhost run CASE --test``; two of them also under
+``mpirun -np 2``) and a few ``pyhost post``
 jobs on the dumps of a real LIGGGHTS pour, and compares every output file byte for byte with
 references saved before a change (issue 45).
 
@@ -33,6 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 HERE = Path(os.environ.get("SAME_OUTPUTS_DIR", ROOT / "out" / "same_outputs"))
 PYTHON = ROOT / ".venv" / "bin" / "python"
 CASES = ("two-particles", "hot-cold-box", "wall-impact", "hot-cold-bed", "packed-bed-ergun", "silo-heat")
+MPI_CASES = ("hot-cold-box", "wall-impact")       # also on two MPI ranks: each rank moves its collisions' heat
 CLOCK_KEYS = {"elapsed_s", "wall_time_s", "wall_s", "seconds", "started", "finished", "host", "version",
               "wall_seconds", "elapsed"}
 CLOCK_COLUMNS = {"wall_time", "wall_s", "elapsed_s"}
@@ -100,6 +102,18 @@ def run_all(into: Path, only=None) -> dict:
         status[case] = (r.returncode, r.stderr.strip().splitlines()[-1:] if r.returncode else [])
         (out / "root").write_text(str(ROOT))
         print(f"{case}: exit {r.returncode}", flush=True)
+    for case in MPI_CASES:
+        name = f"{case}-mpi2"
+        if only and name not in only:
+            continue
+        out = into / name
+        shutil.rmtree(out, ignore_errors=True)
+        r = subprocess.run(["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", "2", str(PYTHON), "-m", "pyhost",
+                            "run", str(ROOT / "cases" / case), "--test", "--out", str(out)],
+                           cwd=ROOT, capture_output=True, text=True, timeout=1800)
+        status[name] = (r.returncode, r.stderr.strip().splitlines()[-1:] if r.returncode else [])
+        (out / "root").write_text(str(ROOT))
+        print(f"{name}: exit {r.returncode}", flush=True)
     p = pour()
     for name, args in post_jobs(p).items():
         if only and name not in only:
