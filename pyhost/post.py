@@ -125,10 +125,10 @@ class Post(ContactDumps):
 
     def wall_codes(self, entry: int, meshes) -> np.ndarray:
         """The partner codes of the meshes ``meshes`` (0 for a plane or primitive wall) of the
-        [[walls]] entry ``entry``, numbered as they first come, in order of mesh (post reads
-        one mesh wall fix's contacts, wall/gran/local's)."""
+        [[walls]] entry ``entry``: an entry's meshes numbered in their order, up to the largest
+        seen, as a run numbers a wall fix's (post reads one mesh wall fix's contacts)."""
         meshes = np.asarray(meshes, np.int64)
-        for m in np.unique(meshes).tolist():
+        for m in range(int(meshes.max(initial=-1)) + 1):
             if (entry, m) not in self.wall_numbers:
                 self.wall_numbers[entry, m] = len(self.wall_entry)
                 self.wall_entry.append(entry)
