@@ -73,11 +73,11 @@ def _sha256(path: Path) -> str:
 def fingerprints(scene, commands) -> dict:
     """SHA-256 of every file the run reads, by absolute path, taken when it starts: a user's
     script, the files it includes and those its commands read (STL meshes, data and restart
-    files: ``pyhost.script.input_files``), and the dictionaries, mesh and starting fields of
+    files: ``pyhost.engines.liggghts.script.input_files``), and the dictionaries, mesh and starting fields of
     the user's OpenFOAM case (its system/, constant/ and start time folder). A restart refuses
     to go on if one changed since (``load``). A box scene's generated script is the host's own:
     its case.toml has its fingerprint of its own."""
-    from pyhost.script import input_files
+    from pyhost.engines.liggghts.script import input_files
 
     files = []
     if scene.scripted:
@@ -140,10 +140,10 @@ def _write_into(coupling, new: Path) -> None:
         # them at its next re-neighbouring, which the set-up after write_restart is; a set-up
         # first drops them from the restart file too (they used to stay in it and not in
         # host.npz: "corrupt checkpoint", exit 2, at the checkpoint after a box emptied)
-        dem.engine_command("run 0 post no")
+        dem.drop_lost()
         kept = np.isin(ids, dem.per_atom(("id",))[0])
         ids, f, torque, release = ids[kept], f[kept], torque[kept], [r[kept] for r in release]
-    dem.engine_command(f"write_restart {new / RESTART}")
+    dem.write_restart(new / RESTART)
     dem.check_restart(new / RESTART)
     dem.run(0)                                   # set up again, then the step's own forces back
     _put_forces(dem, ids, f, torque)
@@ -196,7 +196,7 @@ def load(out: Path, scene, extend: float = 0.0) -> dict:
     and ``extend``, the checkpoint's run's own ``--extend`` [s], which ``extend`` (this run's)
     may not be below. UserError (exit 2) saying why if there is none, it belongs to another case or
     another code version, or it is damaged; nothing is written. (Every scene restarts; a
-    script's commands that a restart cannot replay are refused by ``pyhost.script.replay``.)"""
+    script's commands that a restart cannot replay are refused by ``pyhost.engines.liggghts.script.replay``.)"""
     folder = Path(out) / FOLDER
     if not folder.is_dir() and (Path(out) / ".checkpoint.old").is_dir():
         folder = Path(out) / ".checkpoint.old"    # a write was cut between its two renames

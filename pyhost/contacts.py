@@ -12,28 +12,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyhost.collisions import WALL_BASE
+from pyhost.collisions import minimum_image, wall_code
 from pyhost.walls import face_overlap, primitive_overlap
 
 
 @dataclass(frozen=True)
 class Contacts:
-    """Contacts, one row each: ``i`` a particle (index or atom id); ``j`` a particle, or
-    WALL_BASE + wall index; overlap ``delta`` [m]; unit ``normal`` from j to i; ``approach`` =
-    -(v_i - v_j).n [m/s] (> 0 while closing in); ``heat_flux`` [W] into i by a script's fix
-    heat/gran (zeros without). The form of a contact list that ``pyhost post`` finds in dump
-    frames without contact dumps."""
+    """Contacts, one row each: ``i`` a particle (index or atom id); ``j`` a particle, or the
+    code of the wall of that index among those given (``pyhost.collisions.wall_code``); overlap
+    ``delta`` [m]; unit ``normal`` from j to i; ``approach`` = -(v_i - v_j).n [m/s] (> 0 while
+    closing in). The form of a contact list that ``pyhost post`` finds in dump frames without
+    contact dumps."""
 
     i: np.ndarray
     j: np.ndarray
     delta: np.ndarray
     normal: np.ndarray
     approach: np.ndarray
-    heat_flux: np.ndarray | None = None
-
-    def __post_init__(self):
-        if self.heat_flux is None:
-            object.__setattr__(self, "heat_flux", np.zeros(len(self.i)))
 
     def __len__(self):
         return len(self.i)
@@ -43,7 +38,7 @@ class Contacts:
         """The rows of several lists, in order."""
         if not parts:
             z = np.zeros(0)
-            return cls(np.zeros(0, np.int64), np.zeros(0, np.int64), z, np.zeros((0, 3)), z, z)
+            return cls(np.zeros(0, np.int64), np.zeros(0, np.int64), z, np.zeros((0, 3)), z)
         return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.__dataclass_fields__))
 
 
@@ -67,7 +62,7 @@ class ContactFinder:
         self.x_built, self.pairs, self.rebuilds = None, None, 0
 
     def _wrap(self, d):
-        return d - np.where(self.per, self.size * np.round(d / self.size), 0.0)
+        return minimum_image(d, self.size, self.per)
 
     def _rebuild(self, x) -> None:
         from scipy.spatial import cKDTree   # here: only post's contacts need it (0.1-0.3 s to import)
@@ -100,7 +95,7 @@ class ContactFinder:
         for w, wall in enumerate(self.walls):
             delta, nw = face_overlap(x, r, wall, self.box) if isinstance(wall, str) else primitive_overlap(x, r, wall)
             k = np.flatnonzero(delta > 0)
-            rows.append((k, np.full(len(k), WALL_BASE + w), delta[k], nw[k], -np.einsum("ij,ij->i", v[k], nw[k])))
+            rows.append((k, np.full(len(k), wall_code(w)), delta[k], nw[k], -np.einsum("ij,ij->i", v[k], nw[k])))
         return Contacts.concat([Contacts(*row) for row in rows])
 
 

@@ -4,7 +4,7 @@ likely cause, told from the scene (exit code 3, docs/exit-codes.md).
 Causes, tried in this order for the face the particle was heading to:
 - an open face (no wall, not periodic): nothing holds the particle in;
 - a DEM step too long for the collision at the particle's speed (fewer than 10 steps per
-  DEM collision time, ``pyhost.dem_input.dem_collision_time``): contacts are missed or blow up;
+  DEM collision time, ``pyhost.engines.liggghts.box_input.dem_collision_time``): contacts are missed or blow up;
 - tunnelling through a soft wall: the undamped Hertz overlap at that speed (DEM moduli)
   exceeds the radius, so the wall cannot stop it;
 - blow-out by the gas: leaving upwards through the top while the inlet blows (tried first
@@ -16,7 +16,7 @@ import numpy as np
 
 from plugins.dem.hertz import DemHertz
 from plugins.heat.batch import dem_pair
-from pyhost.dem_input import dem_collision_time
+from pyhost.engines.liggghts.box_input import dem_collision_time
 from pyhost.exitcodes import SimulationFailed
 from pyhost.walls import FACES
 

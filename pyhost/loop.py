@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from pyhost import checkpoint, signals
-from pyhost.dem_input import script_dem_contacts
+from pyhost.engines.liggghts.box_input import script_dem_contacts
 from pyhost.effects.balance import EnergyBalance
 from pyhost.effects.case_commands import CaseCommands, case_commands
 from pyhost.effects.collisions import CollisionHeat
@@ -42,7 +42,7 @@ from pyhost.engines.liggghts import LiggghtsError
 from pyhost.failures import InvariantBroken, particles_lost
 from pyhost.outdir import write_atomic
 from pyhost.output import Progress
-from pyhost.script import Program, ScriptError, if_branches, parse_run, replay
+from pyhost.engines.liggghts.script import Program, ScriptError, if_branches, parse_run, replay
 
 HARVEST_EVERY = 1000
 """DEM steps between harvests of the contact events at most (they are also taken at every

@@ -4,6 +4,7 @@ small files written atomically, so that a crash or a full disk never leaves half
 summary.json."""
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import tempfile
@@ -55,3 +56,19 @@ def write_atomic(path: Path, text: str) -> None:
         if isinstance(exc, OSError) and exc.filename is None:     # a failed write names no file
             exc.filename = str(path)
         raise
+
+
+def run_output(out: Path) -> str | None:
+    """What marks ``out`` as a run's output folder (``pyhost run``), which post must not write
+    into: its scene.json, a file only a run writes (history.csv, collisions.csv, checkpoint,
+    ...: a run of an older version or stopped on a full disk has no scene.json), or a
+    summary.json that is not post's (a run's has a status, post's its frames); None if
+    nothing does."""
+    for name in RUN_FILES:
+        if name not in ("summary.json", "vtk") and (out / name).exists():
+            return name
+    try:
+        summary = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return "summary.json with a status" if not isinstance(summary, dict) or "frames" not in summary else None

@@ -23,120 +23,28 @@ from __future__ import annotations
 import csv
 import gzip
 import json
-from dataclasses import dataclass, field
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 
-from plugins.dem.hertz import DemHertz, hertz_collision_time, impact_speeds, reduced
-from plugins.heat.batch import dem_pair, evaluate_flagged
 from plugins.heat import MODELS
 from plugins.heat.exchange import exchange_heat
-from pyhost.collisions import WALL_BASE, contact_keys
+from pyhost.collisions import (Bodies, FirstAppearances, Found, carried_back, conductances, contact_keys, log_wall,
+                               material_of, shortest_collision, sphere_mass, wall_code, wall_of)
 from pyhost.contacts import find_contacts
-from pyhost.dem_input import script_dem_contacts
-from pyhost.dumps import Clock, DumpError, DumpReader, expand, local_compute, processor_parts
-from pyhost.outdir import write_atomic
+from pyhost.dumps import Clock, DumpError, DumpReader
+from pyhost.engines.liggghts.dump_contacts import ContactDumps
+from pyhost.engines.liggghts.dump_script import script_dem_contacts_of
+from pyhost.engines.liggghts.names import BOX, CONDUCTION, CONDUCTION_FIX, TEMPERATURE, WALL_CONTACTS
+from pyhost.outdir import run_output, write_atomic
 from pyhost.output import Progress, VtkSeries, naming
-from pyhost.scene import read_toml
-from pyhost.schema import Material, SceneError, Wall, build, check_types
-from pyhost.script import ScriptError
-from pyhost.walls import FACES
+from pyhost.scene import PostScene
 
 TEMPERATURES = ("own", "dumps")
 """How post's particle temperatures evolve: ``own``, from each particle's first temperature by
 the models' collision heat (and the script's Temp sets); ``dumps``, taken from the dumps at every
 frame (the run's own conduction and sources), the collisions until the next frame moving heat
 from there: what the models' collisions would move in the run's own temperature field."""
-MESHES = 64                  # wall partner number = WALL_BASE + MESHES * wall index + mesh index
-
-
-@dataclass(frozen=True)
-class PostScene:
-    path: Path
-    materials: dict                 # name -> Material (real and DEM values, types, temperature)
-    types: dict                     # LIGGGHTS atom type -> material index
-    temperature: dict               # initial temperature per atom type [K]; 0: from the dumps
-    walls: list                     # pyhost.scene.Wall
-
-
-def load_post_scene(path) -> PostScene:
-    """The ``[materials.NAME]`` (with ``types`` and an optional ``temperature``) and ``[[walls]]``
-    (``fix`` or ``plane``, ``material``, ``temperature``) of a scene file; its other sections
-    belong to runs and are not read here, so a case.toml serves both."""
-    path, file = Path(path), str(path)
-    data = read_toml(path)
-    if not isinstance(data.get("materials"), dict) or not data["materials"]:
-        raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
-    materials = {name: build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
-    names = list(materials)
-    types = {t: names.index(name) for t, name in check_types(materials, file).items()}
-    if not types:
-        raise SceneError(f"{file}: materials: no material names its LIGGGHTS atom types (types = [1, 2])")
-    if not isinstance(data.get("walls", []), list):
-        raise SceneError(f"{file}: walls: must be [[walls]] tables")
-    walls = [build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
-    for k, wall in enumerate(walls):
-        if wall.material not in materials:
-            raise SceneError(f"{file}: walls[{k}].material: unknown material {wall.material!r}; "
-                             f"known: {', '.join(materials)}")
-        if bool(wall.fix) == bool(wall.plane):
-            raise SceneError(f"{file}: walls[{k}]: give either fix (a LIGGGHTS wall fix id) or plane "
-                             f"({', '.join(FACES)})")
-    return PostScene(path, materials, types, {t: materials[names[k]].temperature_of(t) for t, k in types.items()},
-                     walls)
-
-
-def run_output(out: Path) -> str | None:
-    """What marks ``out`` as a run's output folder (``pyhost run``), which post must not write
-    into: its scene.json, a file only a run writes (history.csv, collisions.csv, checkpoint,
-    ...: a run of an older version or stopped on a full disk has no scene.json), or a
-    summary.json that is not post's (a run's has a status, post's its frames); None if
-    nothing does."""
-    from pyhost.outdir import RUN_FILES
-    for name in RUN_FILES:
-        if name not in ("summary.json", "vtk") and (out / name).exists():
-            return name
-    try:
-        summary = json.loads((out / "summary.json").read_text())
-    except (OSError, ValueError):
-        return None
-    return "summary.json with a status" if not isinstance(summary, dict) or "frames" not in summary else None
-
-
-class ScriptDem:
-    """The DEM values the script that wrote the dumps sets (``fix ... property/global``, plain
-    numbers; ``pyhost.dumps.Script.globals``), behind the part of the engine's interface that
-    ``pyhost.dem_input.script_dem_contacts`` reads: post's DEM contact of each material comes
-    from the script as a run's comes from the engine, and a [materials.NAME.dem] table must
-    agree with it. ``unread``: the values given as variables, which post cannot evaluate."""
-
-    def __init__(self, script):
-        numbers = {}
-        self.unread = {}
-        for prop, (where, words) in script.globals.items():
-            try:
-                numbers[prop] = (where, words[0], [float(x) for x in words[1:]])
-            except ValueError:
-                self.unread[prop] = where
-        self.values = numbers
-        self.info = SimpleNamespace(globals=numbers, wall_type=script.wall_types.get)
-
-    def _value(self, prop, k):
-        where, style, v = self.values[prop]
-        try:
-            return v[k]
-        except IndexError:
-            raise ScriptError(f"{where}: property/global {prop} {style}: too few values for the dumps' atom types") \
-                from None
-
-    def type_values(self, prop, types) -> np.ndarray:
-        return np.array([self._value(prop, int(t) - 1) for t in types])
-
-    def type_pair_value(self, prop, a, b) -> float:
-        n = int(self.values[prop][2][0]) if self.values[prop][2] else 0
-        return self._value(prop, 1 + (a - 1) * n + (b - 1))
 
 
 class Particles:
@@ -158,50 +66,19 @@ class Particles:
             self.T0[ids] = np.where(np.isnan(self.T0[ids]), temperature, self.T0[ids])
 
 
-@dataclass
-class Found:
-    """Collisions found (first appearances), as lists of arrays until ``array()``."""
-
-    columns = ("step", "i", "j", "delta", "approach", "window")
-    parts: dict = field(default_factory=lambda: {c: [] for c in Found.columns})
-
-    def add(self, **arrays) -> None:
-        for c in self.columns:
-            self.parts[c].append(np.broadcast_to(arrays[c], np.shape(arrays["i"])).astype(float))
-
-    def count(self) -> int:
-        return sum(len(a) for a in self.parts["i"])
-
-    def array(self) -> dict:
-        out = {c: np.concatenate(v) if v else np.zeros(0) for c, v in self.parts.items()}
-        order = np.argsort(out["step"], kind="stable")
-        out = {c: a[order] for c, a in out.items()}
-        out["i"], out["j"] = out["i"].astype(np.int64), out["j"].astype(np.int64)
-        return out
-
-
-class FirstAppearances:
-    """Keys of the previous frame of one contact stream; ``new(keys)`` gives which are new."""
-
-    def __init__(self):
-        self.previous = np.empty(0, np.int64)
-
-    def new(self, keys):
-        fresh = ~np.isin(keys, self.previous)
-        self.previous = keys
-        return fresh
-
-
 ATOMS_REQUIRED = ("id", "type", "position", "velocity", "radius")
 
 
-class Post:
-    """One post-processing job; ``run()`` writes the output folder and returns the summary."""
+class Post(ContactDumps):
+    """One post-processing job; ``run()`` writes the output folder and returns the summary.
+    ``heat_path``: the plugin's evaluation path (``fast`` or ``exact``, as a run's
+    effects.heat_path)."""
 
     def __init__(self, dumps, scene: PostScene, out, contacts=(), script=None, computes=None, models=tuple(MODELS),
-                 dt=None, skip_bad_frames=False, temperatures="own", progress_every=5.0):
+                 dt=None, skip_bad_frames=False, temperatures="own", progress_every=5.0, heat_path="fast"):
         if temperatures not in TEMPERATURES:
             raise ValueError(f"temperatures: {temperatures!r} is not one of {', '.join(TEMPERATURES)}")
+        self.heat_path = heat_path
         self.temperatures = temperatures
         self.progress_every = progress_every    # wall seconds between progress lines [s]
         self.dumps, self.scene, self.out = list(dumps), scene, Path(out)
@@ -217,9 +94,9 @@ class Post:
             self.clock = Clock.steady(dt)
         self.warnings = list(script.warnings) if script else []
         if script and script.heat_gran and temperatures == "own":
-            self.warnings.append(f"the script conducts heat with fix heat/gran ({', '.join(script.heat_gran)}): post's "
+            self.warnings.append(f"the script conducts heat with {CONDUCTION_FIX} ({', '.join(script.heat_gran)}): post's "
                                  "temperatures change by its models' collision heat and the script's Temp sets only, "
-                                 "not by heat/gran's conduction through lasting contacts or its heat sources "
+                                 f"not by {CONDUCTION}'s conduction through lasting contacts or its heat sources "
                                  "(--temperatures dumps takes the dumped temperatures at every frame)")
         self.materials = self.dem_contacts(scene, script)
         if script:
@@ -230,6 +107,8 @@ class Post:
                                      f"{scene.path}: their collisions are not counted")
         self.series = None               # the VTK series of the particles, once written
         self.particles = Particles()
+        # the walls by number (pyhost.collisions.wall_code): each one's [[walls]] entry, one per wall and mesh
+        self.wall_entry, self.wall_numbers = [], {}
         self.frame_steps = set()        # the steps of the particle frames
         self.same_run = {}              # step -> a contact frame to check against the particle frame of that step
         self.summary = dict(frames=0, particles=0, collisions=dict(particle_particle=0, particle_wall=0),
@@ -242,15 +121,18 @@ class Post:
     def dem_contacts(scene: PostScene, script) -> list:
         """The scene's materials, each with the DEM contact the script sets for its atom types
         (checked against a given dem table), or its table where there is no script."""
-        if script is None:
-            return list(scene.materials.values())
-        dem = ScriptDem(script)
-        try:
-            return script_dem_contacts(scene, dem)
-        except ScriptError as exc:
-            unread = "; ".join(f"{where}: {prop}" for prop, where in dem.unread.items())
-            raise ScriptError(f"{exc}" + (f" (post reads plain numbers; given as variables: {unread})" if unread
-                                           else "")) from None
+        return list(scene.materials.values()) if script is None else script_dem_contacts_of(scene, script)
+
+    def wall_codes(self, entry: int, meshes) -> np.ndarray:
+        """The partner codes of the meshes ``meshes`` (0 for a plane or primitive wall) of the
+        [[walls]] entry ``entry``: an entry's meshes numbered in their order, up to the largest
+        seen, as a run numbers a wall fix's (post reads one mesh wall fix's contacts)."""
+        meshes = np.asarray(meshes, np.int64)
+        for m in range(int(meshes.max(initial=-1)) + 1):
+            if (entry, m) not in self.wall_numbers:
+                self.wall_numbers[entry, m] = len(self.wall_entry)
+                self.wall_entry.append(entry)
+        return wall_code(np.array([self.wall_numbers[entry, m] for m in meshes.tolist()], np.int64))
 
     # -- reading ----------------------------------------------------------------------------
     def reader(self, paths, **kw):
@@ -279,12 +161,14 @@ class Post:
         found, first = Found(), FirstAppearances()
         walls = [(k, w.plane) for k, w in enumerate(self.scene.walls) if w.plane]  # box faces, primitive walls
         if not self.contacts:
+            for k in range(len(self.scene.walls)):      # numbered as the entries (one mesh each)
+                self.wall_codes(k, [0])
             primitives = self.script.primitives if self.script else {}
             for k, w in enumerate(self.scene.walls):
                 if w.fix in primitives:
                     walls.append((k, primitives[w.fix]))
                 elif w.fix:
-                    self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps (wall/gran/local), "
+                    self.warnings.append(f"wall fix {w.fix}: its contacts need --contacts dumps ({WALL_CONTACTS}), "
                                          "or --script when it is a primitive wall; without them it is ignored")
         steps, last = [], None
         progress = Progress(float("inf"), self.progress_every)
@@ -309,11 +193,6 @@ class Post:
         self.interval = (min(zip(np.diff(self.clock.time(steps)), np.diff(steps))) if len(steps) > 1 else None)
         return found
 
-    def temperature_column(self, f) -> str | None:
-        """The frame's column of LIGGGHTS' particle temperature (f_Temp, or a heat/gran's own)."""
-        return next((c for c in ("f_Temp", *(f"f_{h}" for h in (self.script.heat_gran if self.script else ())))
-                     if c in f), None)
-
     def frame_box(self, f):
         """The frame's box (3, 2) [m]; a VTK dump has none: the script's (``--script``)."""
         return f.box if f.box is not None else (self.script.box if self.script else None)
@@ -325,13 +204,13 @@ class Post:
         box = self.frame_box(f)
         if any(isinstance(w, str) for _, w in walls) and box is None:
             raise ValueError(f"{f.file}: a VTK dump has no box, so walls on its faces cannot be placed: give --script "
-                             "(its create_box), or use text dumps")
+                             f"(its {BOX}), or use text dumps")
         x = f.positions()
         box = box if box is not None else np.stack([x.min(0) - 1.0, x.max(0) + 1.0], axis=1)
         c = find_contacts(x, f.vector("v"), f["radius"], box.ravel(), f.periodic, [p for _, p in walls])
-        wall = c.j >= WALL_BASE
+        wall, w = wall_of(c.j)
         j = ids[np.where(wall, 0, c.j)]
-        j[wall] = WALL_BASE + MESHES * np.array([k for k, _ in walls], np.int64)[c.j[wall] - WALL_BASE]
+        j[wall] = np.array([self.wall_codes(k, [0])[0] for k, _ in walls], np.int64)[w[wall]]
         keys = contact_keys(ids[c.i], j)
         new = first.new(keys)
         if len(steps) == 1:
@@ -350,199 +229,32 @@ class Post:
             self.warnings.append(f"{n} contacts are open in the first frame of {Path(f.file).name} (timestep "
                                  f"{f.step}): they began before the dumps do, so they are not counted as collisions")
 
-    def contact_streams(self) -> dict:
-        """Contact dump files grouped by the compute their columns come from (one stream each)."""
-        streams = {}
-        heads, parts = processor_parts(expand(self.contacts))    # (an MPI run's files per processor)
-        for p in heads:
-            streams.setdefault(local_compute(p), []).extend([p, *parts.get(p, ())])
-        return streams
-
-    def dump_contacts(self, found: Found) -> None:
-        """Collisions from contact dumps: a contact's first appearance in its stream."""
-        intervals = []
-        for cid, paths in self.contact_streams().items():
-            first, previous = FirstAppearances(), None
-            progress = Progress(float("inf"), self.progress_every)
-            for f in self.frames(self.reader(paths, computes=self.computes)):
-                progress.update(f.time, f"; reading the contact dumps of {cid}: {found.count()} collisions found")
-                if f.kind not in ("pair", "wall"):
-                    raise DumpError(f.file, f.timestep, f.line, "not a dump of compute pair/gran/local or wall/gran/local")
-                missing = [g for g in ("x_i", "v_i", "id_i") + (("x_j", "v_j", "id_j") if f.kind == "pair"
-                                                                  else ("x_contact", "v_wall", "mesh"))
-                           if g not in f.groups]
-                if missing:
-                    raise DumpError(f.file, f.timestep, f.line, f"contact dump lacks {', '.join(missing)}: the compute "
-                                                            "needs the keywords pos, vel and id, all dumped")
-                window = f.time - previous[1] if previous is not None else None
-                if previous is not None:
-                    intervals.append((window, f.step - previous[0]))
-                previous = (f.step, f.time)
-                if len(f):
-                    self.add_dump_contacts(f, cid, first, found, window)
-                else:
-                    first.new(np.empty(0, np.int64))        # an empty frame ends every contact
-        if intervals:
-            self.interval = min(intervals)
-        self.check_same_run()
-
-    def wall_index(self, cid: str) -> int:
-        fixes = [k for k, w in enumerate(self.scene.walls) if w.fix]
-        if self.script and self.script.mesh_wall_fixes:
-            fix = self.script.mesh_wall_fixes[-1]       # wall/gran/local reports the last mesh wall fix
-            match = [k for k in fixes if self.scene.walls[k].fix == fix]
-            if not match:
-                raise ValueError(f"{self.scene.path}: wall contacts of compute {cid} come from fix {fix}: "
-                                 f"no [[walls]] entry has fix = {fix!r}")
-            return match[0]
-        if len(fixes) != 1:
-            raise ValueError(f"{self.scene.path}: wall contacts of compute {cid}: which [[walls]] entry they belong "
-                             f"to needs exactly one wall with 'fix', or --script; {len(fixes)} have one")
-        return fixes[0]
-
-    SAME_RUN_FRAMES = 8     # contact frames checked against the particle dumps
-
-    def keep_for_same_run(self, f, ids_i) -> None:
-        """The first few contact frames with rows at a step the particle dumps also have, for
-        ``check_same_run``."""
-        if f.step in self.frame_steps and f.step not in self.same_run and len(self.same_run) < self.SAME_RUN_FRAMES:
-            self.same_run[f.step] = (f.file, f.timestep, f.line, ids_i.copy(), f.vector("x_i").copy())
-
-    def check_same_run(self) -> None:
-        """Contact frames at steps the particle dumps also have: their particles must be where
-        those dumps put them (contact dumps of another run with the same ids would otherwise
-        be taken for this one's). The particle dumps are read again up to the last such step:
-        only the first 8 particle frames were kept, so a run whose first contacts come later
-        (particle dumps every 20 steps of a pour) was never checked. Tolerance: the dumps' 6
-        significant digits. A warning when no contact frame with rows shares a step with them."""
-        if not self.same_run:
-            self.warnings.append("no contact frame with contacts is at a step of the particle dumps: that the "
-                                 "contact dumps are of the run the particle dumps are of is not checked")
-            return
-        pending = dict(self.same_run)
-        for f in DumpReader(self.dumps, clock=self.clock, skip_bad_frames=self.skip, require=("id", "position")):
-            if f.step in pending:
-                self.compare_positions(pending.pop(f.step), f)
-            if not pending or f.step > max(pending):
-                return
-
-    def compare_positions(self, contact, f) -> None:
-        file, timestep, line, ids_i, x_i = contact
-        ids, x, box, periodic = f["id"].astype(np.int64), f.positions(), self.frame_box(f), f.periodic
-        at = np.full(int(max(ids.max(initial=0), ids_i.max(initial=0))) + 1, -1)
-        at[ids] = np.arange(len(ids))
-        rows = at[ids_i]
-        seen = rows >= 0
-        d = x_i[seen] - x[rows[seen]]
-        if box is not None:
-            size = box[:, 1] - box[:, 0]
-            d -= np.where(periodic, size * np.round(d / size), 0.0)
-            scale = np.abs(box).max()
-        else:
-            scale = np.abs(x).max(initial=0.0)
-        tol = 1e-5 * scale + 1e-3 * self.particles.radius[ids_i[seen]]
-        far = np.flatnonzero(np.linalg.norm(d, axis=1) > tol)
-        if len(far):
-            k = far[0]
-            raise DumpError(file, timestep, line,
-                            f"particle {ids_i[seen][k]} is at {x_i[seen][k].tolist()} m here and at "
-                            f"{x[rows[seen][k]].tolist()} m in the particle dumps at the same step: the contact "
-                            "dumps are not of the run the particle dumps are of")
-
-    def add_dump_contacts(self, f, cid, first, found, window) -> None:
-        ids_i = self.checked_ids(f, f["id_i"])
-        self.keep_for_same_run(f, ids_i)
-        r_i = self.particles.radius[ids_i]
-        if f.kind == "pair":
-            ids_j = self.checked_ids(f, f["id_j"])
-            d = f.vector("x_i") - f.vector("x_j")
-            size = f.box[:, 1] - f.box[:, 0]
-            d -= np.where(f.periodic, size * np.round(d / size), 0.0)
-            v_rel = f.vector("v_i") - f.vector("v_j")
-            gap = self.particles.radius[ids_j] + r_i
-            j = ids_j
-        else:
-            d = f.vector("x_i") - f.vector("x_contact")
-            v_rel = f.vector("v_i") - f.vector("v_wall")
-            gap = r_i
-            j = WALL_BASE + MESHES * self.wall_index(cid) + f["mesh"].astype(np.int64)
-        dist = np.linalg.norm(d, axis=1)
-        n = d / np.where(dist > 0, dist, 1.0)[:, None]
-        delta = f["delta"] if "delta" in f else gap - dist
-        approach = -np.einsum("ij,ij->i", v_rel, n)
-        keys = contact_keys(ids_i, j)
-        order = np.lexsort((-delta, keys))               # per key, the row of largest overlap first
-        keys, first_row = np.unique(keys[order], return_index=True)
-        rows = order[first_row]
-        new = first.new(keys)
-        if window is None:                               # the stream's first frame
-            self.open_at_start(f, len(keys))
-            return
-        rows = rows[new]
-        found.add(step=f.step, i=ids_i[rows], j=j[rows], delta=delta[rows], approach=approach[rows], window=window)
-
-    def checked_ids(self, f, ids):
-        ids = ids.astype(np.int64)
-        known = (ids < len(self.particles.type)) & (ids > 0)
-        known[known] = self.particles.type[ids[known]] > 0
-        if not known.all():
-            raise DumpError(f.file, f.timestep, f.line, f"particle id {ids[~known][0]} is in no particle dump")
-        return ids
-
     # -- physics from the plugin ---------------------------------------------------------------
-    def material_of(self, types):
-        """Material index of LIGGGHTS atom types (scene's materials.NAME.types)."""
-        lookup = np.zeros(max(self.scene.types) + 1, int)
-        lookup[list(self.scene.types)] = list(self.scene.types.values())
-        return lookup[types]
-
-    def bodies(self, i, j):
-        """Material index, radius [m] and mass [kg] of partners i (particles) and j (particle
-        or wall), and whether j is a wall and which."""
-        mats = self.materials
-        density = np.array([m.density for m in mats])
-        wall = j >= WALL_BASE
-        w = np.where(wall, (j - WALL_BASE) // MESHES, 0)
-        wall_mat = np.array([list(self.scene.materials).index(x.material) for x in self.scene.walls] or [0])
-        jj = np.where(wall, 0, j)
-        mi = self.material_of(self.particles.type[i])
-        mj = np.where(wall, wall_mat[w], self.material_of(self.particles.type[jj]))
-        R_i, R_j = self.particles.radius[i], np.where(wall, np.inf, self.particles.radius[jj])
-        m_i = 4.0 / 3.0 * np.pi * R_i**3 * density[mi]
-        m_j = np.where(wall, np.inf, 4.0 / 3.0 * np.pi * R_j**3 * density[mj])
-        return mi, mj, R_i, R_j, m_i, m_j, wall, w
-
-    def dem_laws(self, mi, mj):
-        mats = self.materials
-        laws = {}
-        for a, b in set(zip(mi.tolist(), mj.tolist())):
-            for k in (a, b):
-                if mats[k].dem is None:
-                    raise ValueError(f"{self.scene.path}: materials.{list(self.scene.materials)[k]}.dem: post "
-                                     f"recovers impact speeds with the DEM's contact law: give the table "
-                                     f"(youngs_modulus, restitution, poisson_ratio), or --script with the script's "
-                                     f"fix property/global")
-            dem = dem_pair(mats[a], mats[b])
-            laws[a, b] = (dem.Ystar, DemHertz(dem.Ystar, dem.restitution))
-        return laws
+    def partners(self, i, j):
+        """The bodies (``pyhost.collisions.Bodies``) and both partners of collisions of
+        particles ``i`` with partners ``j`` (ids or wall codes)."""
+        names = list(self.scene.materials)
+        type_material = np.full(max(self.scene.types) + 1, -1)
+        type_material[list(self.scene.types)] = list(self.scene.types.values())
+        bodies = Bodies(self.materials, type_material,
+                        np.array([names.index(self.scene.walls[k].material) for k in self.wall_entry], int))
+        jj = np.where(wall_of(j)[0], 0, j)
+        t, R = self.particles.type, self.particles.radius
+        return bodies, bodies.partners(j, material_of(type_material, t[i]), R[i], material_of(type_material, t[jj]),
+                                       R[jj])
 
     def impact_speeds(self, c) -> np.ndarray:
-        mi, mj, R_i, R_j, m_i, m_j, _, _ = self.bodies(c["i"], c["j"])
-        R, m = reduced(R_i, R_j, m_i, m_j)
-        laws = self.dem_laws(mi, mj)
-        v0 = impact_speeds(c["approach"], lambda a, b: laws[a, b][1], mi, mj, c["delta"], c["approach"], R, m,
-                           c["window"], mask=c["delta"] > 0)
-        self.shortest_collision(mi, mj, R, m, v0)
+        """Each collision's impact speed [m/s], its approach speed carried back to touch."""
+        bodies, p = self.partners(c["i"], c["j"])
+        names = list(self.scene.materials)
+        v0 = carried_back(bodies, p, c["approach"], c["delta"], c["window"], names, self.scene.path)
+        if len(v0) and self.interval is not None:
+            self.shortest_collision(*shortest_collision(bodies, p, v0, names, self.scene.path))
         return v0
 
-    def shortest_collision(self, mi, mj, R, m, v0) -> None:
-        """The DEM's shortest Hertz collision time among the collisions found, at the fastest
-        impact seen (1 m/s if none), against the dump interval."""
-        if not len(v0) or self.interval is None:
-            return
-        v = float(v0.max()) if np.any(v0 > 0) else 1.0
-        t_c = min(hertz_collision_time(Y, R[(mi == a) & (mj == b)].min(), m[(mi == a) & (mj == b)].min(), v)
-                  for (a, b), (Y, _) in self.dem_laws(mi, mj).items())
+    def shortest_collision(self, t_c: float, v: float) -> None:
+        """The DEM's shortest collision time t_c [s] among the collisions found (at the fastest
+        impact v [m/s]) against the dump interval."""
         interval, steps = self.interval
         self.summary.update(dump_interval_s=interval, shortest_collision_s=t_c)
         if interval > t_c:
@@ -585,8 +297,8 @@ class Post:
         """Models over all collisions, heat moved in time order while the particle frames are
         replayed into the VTK series; collisions.csv.gz written batch by batch."""
         n = len(c["i"])
-        mi, mj, R_i, R_j, m_i, m_j, wall, w = self.bodies(c["i"], c["j"])
-        mats = self.materials
+        bodies, p = self.partners(c["i"], c["j"])
+        wall, mats = p.wall, self.materials
         go = c["v0"] > 0                     # contacts that formed without approach move no collision heat
         if (~go).any():
             self.warnings.append(f"{int((~go).sum())} contacts formed with no approach speed: no collision heat")
@@ -596,8 +308,7 @@ class Post:
             G[model], e[model], t_coll[model] = np.zeros(n), np.full(n, np.nan), np.full(n, np.nan)
             flagged = np.zeros(0, bool)
             if go.any():
-                g, ee, tt, flagged = evaluate_flagged(model, "fast", mats, mi[go], mj[go], R_i[go], R_j[go], c["v0"][go],
-                                                      np.ones(go.sum()))
+                g, ee, tt, flagged = conductances(model, self.heat_path, bodies, p[go], c["v0"][go])
                 G[model][go], e[model][go], t_coll[model][go] = g, ee, tt
             self.summary["outside_model_range"][model] = int(flagged.sum())
             if flagged.any():
@@ -609,13 +320,13 @@ class Post:
         known = self.particles.type > 0
         heat_capacity = np.array([m.heat_capacity for m in mats])
         density = np.array([m.density for m in mats])
-        mat = self.material_of(self.particles.type[known])
-        C[known] = 4.0 / 3.0 * np.pi * self.particles.radius[known] ** 3 * density[mat] * heat_capacity[mat]
+        mat = material_of(bodies.type_material, self.particles.type[known])
+        C[known] = sphere_mass(self.particles.radius[known], density[mat]) * heat_capacity[mat]
         T0 = self.initial_temperatures(known, mat)
         T = {m: T0.copy() for m in self.models}
         received = {m: np.zeros(len(T0)) for m in self.models}
-        T_wall = np.array([x.temperature if x.temperature > 0 else np.nan for x in self.scene.walls] or [np.nan])
-        j_exchange = np.where(wall, WALL_BASE + w, c["j"])
+        T_wall = np.array([self.scene.walls[k].temperature if self.scene.walls[k].temperature > 0 else np.nan
+                           for k in self.wall_entry] or [np.nan])
         counted = dict(particle_particle=int((~wall).sum()), particle_wall=int(wall.sum()))
         self.summary["collisions"] = counted
         self.summary["capped"] = {m: 0 for m in self.models}
@@ -643,7 +354,7 @@ class Post:
                 if end == done:
                     return
                 for m in self.models:
-                    moved, capped, _ = exchange_heat(T[m], C, c["i"][s], j_exchange[s], G[m][s], T_wall)
+                    moved, capped, _ = exchange_heat(T[m], C, c["i"][s], c["j"][s], G[m][s], T_wall)
                     Q[m][s] = moved
                     np.add.at(received[m], c["i"][s], -moved)
                     pp = ~wall[s]
@@ -652,7 +363,7 @@ class Post:
                     self.summary["heat_J"][m] += float(np.abs(moved).sum())
                 np.add.at(pair_sum, pair_of[s], np.abs(Q[self.models[0]][s]))
                 cols = [self.clock.time(c["step"][s]), c["i"][s], np.where(wall[s], 0, c["j"][s]), type_i[s], type_j[s],
-                        np.where(wall[s], w[s] + 1, 0), c["v0"][s]]
+                        log_wall(c["j"][s], self.wall_entry), c["v0"][s]]
                 for m in self.models:
                     cols += [Q[m][s], e[m][s], t_coll[m][s]]
                 out.writerows(zip(*(np.asarray(a).tolist() for a in cols)))
@@ -678,7 +389,7 @@ class Post:
                 if self.temperatures == "dumps":      # the run's own temperatures from here to the next frame
                     if column is None:
                         raise DumpError(f.file, f.timestep, f.line, "--temperatures dumps: the frame has no particle "
-                                                                "temperature (f_Temp)")
+                                                                f"temperature ({TEMPERATURE})")
                     for m in self.models:
                         T[m][ids] = f[column]
                 fields = dict(id=ids, type=f["type"].astype(int), radius=f["radius"], velocity=f.vector("v"))
@@ -707,7 +418,7 @@ class Post:
         said = [f"{where}: {command}" for _, where, command in temperature_sets]
         column = self.temperature_column(f)
         if before[2] is None or column is None:
-            self.warnings.append(f"{'; '.join(said)}: the dumps have no particle temperature (f_Temp), so post's "
+            self.warnings.append(f"{'; '.join(said)}: the dumps have no particle temperature ({TEMPERATURE}), so post's "
                                  "temperatures do not follow it")
             return
         ids0, T0 = before[1], before[2]
@@ -730,5 +441,5 @@ class Post:
         missing = known & np.isnan(T0)
         if missing.any():
             name = list(self.scene.materials)[mat[np.flatnonzero(missing[known])[0]]]
-            raise ValueError(f"{self.scene.path}: materials.{name}.temperature: needed (the dumps hold no f_Temp)")
+            raise ValueError(f"{self.scene.path}: materials.{name}.temperature: needed (the dumps hold no {TEMPERATURE})")
         return T0

@@ -54,6 +54,8 @@ from plugins.heat import MODELS
 from pyhost.schema import (Conduction, Dem, Domain, Effects, Fluid, Material, Output, Particles,  # noqa: F401
                            check_types, Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
 from pyhost.validate import check_scene
+from pyhost.engines.liggghts.names import CONDUCTION_FIX, COUPLING_FIX, WALL_FIX
+from pyhost.walls import FACES
 
 
 def _box(values, key, file, n=6):
@@ -189,15 +191,7 @@ def load_scene(path) -> Scene:
         _script_keys(dem, path, file)
     check_raw(data, file)
     effects = build(Effects, data.get("effects", {}), "effects", file)
-    if not isinstance(data["materials"], dict) or not data["materials"]:
-        raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
-    materials = {name: build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
-    for name, m in materials.items():
-        if m.b2 <= m.b1:
-            raise SceneError(f"{file}: materials.{name}.b2: must exceed b1 ({m.b1}), got {m.b2}")
-    if not isinstance(data.get("walls", []), list):
-        raise SceneError(f"{file}: walls: must be [[walls]] tables")
-    walls = [build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+    materials, walls = materials_and_walls(data, file)
     if scripted:
         particles, domain = [], None
         _types(materials, walls, file)
@@ -207,10 +201,7 @@ def load_scene(path) -> Scene:
                 raise SceneError(f"{file}: materials.{name}.dem: missing (the DEM's softened contact; a box scene "
                                  "has no script to read it from)")
         particles, domain = _box_world(data, materials, walls, file)
-    for k, item in enumerate(walls):
-        if item.material not in materials:
-            raise SceneError(f"{file}: walls[{k}].material: unknown material {item.material!r}; "
-                             f"known: {', '.join(materials)}")
+    check_wall_materials(walls, materials, file)
     time = build(Time, data.get("time", {}), "time", file)
     if not scripted:
         for key in ("dem_step", "end"):
@@ -243,6 +234,59 @@ def load_scene(path) -> Scene:
     return scene
 
 
+def materials_and_walls(data: dict, file: str) -> tuple[dict, list]:
+    """The ``[materials.NAME]`` tables (name -> Material) and ``[[walls]]`` (Wall) of a scene's
+    data: a run's scene and post's read them alike."""
+    if not isinstance(data.get("materials"), dict) or not data["materials"]:
+        raise SceneError(f"{file}: materials: must be one or more [materials.NAME] tables")
+    materials = {name: build(Material, m, f"materials.{name}", file) for name, m in data["materials"].items()}
+    for name, m in materials.items():
+        if m.b2 <= m.b1:
+            raise SceneError(f"{file}: materials.{name}.b2: must exceed b1 ({m.b1}), got {m.b2}")
+    if not isinstance(data.get("walls", []), list):
+        raise SceneError(f"{file}: walls: must be [[walls]] tables")
+    return materials, [build(Wall, w, f"walls[{k}]", file) for k, w in enumerate(data.get("walls", []))]
+
+
+def check_wall_materials(walls: list, materials: dict, file: str) -> None:
+    """Each wall's material is one of the scene's."""
+    for k, item in enumerate(walls):
+        if item.material not in materials:
+            raise SceneError(f"{file}: walls[{k}].material: unknown material {item.material!r}; "
+                             f"known: {', '.join(materials)}")
+
+
+@dataclasses.dataclass(frozen=True)
+class PostScene:
+    """What ``pyhost post`` reads of a scene file (``load_post_scene``)."""
+
+    path: Path
+    materials: dict                 # name -> Material (real and DEM values, types, temperature)
+    types: dict                     # LIGGGHTS atom type -> material index
+    temperature: dict               # initial temperature per atom type [K]; 0: from the dumps
+    walls: list                     # pyhost.scene.Wall
+
+
+def load_post_scene(path) -> PostScene:
+    """The ``[materials.NAME]`` (with ``types`` and an optional ``temperature``) and ``[[walls]]``
+    (``fix`` or ``plane``, ``material``, ``temperature``) of a scene file, read as a run reads
+    them (``pyhost.scene``); its other sections belong to runs and are not read here, so a
+    case.toml serves both."""
+    path, file = Path(path), str(path)
+    materials, walls = materials_and_walls(read_toml(path), file)
+    names = list(materials)
+    types = {t: names.index(name) for t, name in check_types(materials, file).items()}
+    if not types:
+        raise SceneError(f"{file}: materials: no material names its LIGGGHTS atom types (types = [1, 2])")
+    check_wall_materials(walls, materials, file)
+    for k, wall in enumerate(walls):
+        if bool(wall.fix) == bool(wall.plane):
+            raise SceneError(f"{file}: walls[{k}]: give either fix, the id of a LIGGGHTS {WALL_FIX}, or plane "
+                             f"({', '.join(FACES)})")
+    return PostScene(path, materials, types, {t: materials[names[k]].temperature_of(t) for t, k in types.items()},
+                     walls)
+
+
 def _conduction(effects, conduction, fluid, file):
     """The lasting conduction's settings, checked against the effects: a contact model does not
     go with enduring_conduction (LIGGGHTS' heat/gran would conduct through the same contacts); a
@@ -251,7 +295,7 @@ def _conduction(effects, conduction, fluid, file):
     if effects.contact_conduction != "none" and effects.enduring_conduction:
         raise SceneError(f"{file}: effects.contact_conduction: {effects.contact_conduction!r} and "
                          "effects.enduring_conduction both conduct through lasting contacts (the second through "
-                         "LIGGGHTS' fix heat/gran): choose one")
+                         f"LIGGGHTS' {CONDUCTION_FIX}): choose one")
     if effects.gap_conduction == "none":
         return conduction
     if conduction.gas_conductivity == 0:
@@ -409,12 +453,13 @@ def _cfdem_settings(effects, fluid, time, dem, data, path, file):
         if not given:
             taken[table][key] = ours
     if dem.script and "time.couple_every" not in found:       # (a file exchange: the script's interval)
-        every = _script_couple_every(path.resolve().parent / dem.script)
+        from pyhost.engines.liggghts.script import script_couple_every
+        every = script_couple_every(path.resolve().parent / dem.script)
         if every is not None:
             number, line = every
             if "couple_every" in data.get("time", {}) and time.couple_every != number:
                 raise SceneError(f"{file}: time.couple_every: {time.couple_every}, but {line} couples every "
-                                 f"{number} DEM steps (fix couple/cfd): remove time.couple_every to take the "
+                                 f"{number} DEM steps ({COUPLING_FIX}): remove time.couple_every to take the "
                                  "script's, or make them agree")
             taken["time"]["couple_every"] = number
     return tuple(dataclasses.replace(tables[k], **taken[k]) for k in ("effects", "fluid", "time"))
@@ -436,24 +481,14 @@ def _case_commands(folder: Path, file: str) -> None:
         raise SceneError(f"{file}: fluid.case: {exc}") from None
 
 
-def _script_couple_every(script: Path) -> tuple[int, str] | None:
-    """``couple_every N`` of a CFDEM script's ``fix ID GROUP couple/cfd`` (the script's own text,
-    not its includes) and where it is, or None."""
-    for k, line in enumerate(script.read_text(errors="replace").splitlines(), 1):
-        m = re.match(r"\s*fix\s+\S+\s+\S+\s+couple/cfd\b.*?\bcouple_every\s+(\d+)\b", line.split("#")[0])
-        if m:
-            return int(m.group(1)), f"{script}:{k}"
-    return None
-
-
 def _types(materials, walls, file):
     """Script scenes: each material names its atom types, no type twice (a list of temperatures
     one per type); walls name a fix."""
     check_types(materials, file)
     for k, w in enumerate(walls):
         if not w.fix or w.plane:
-            raise SceneError(f"{file}: walls[{k}]: a script scene names a LIGGGHTS wall by fix = \"ID\" "
-                             "(the id of its fix wall/gran), not by plane")
+            raise SceneError(f"{file}: walls[{k}]: a script scene names a LIGGGHTS wall by \"fix\", the id of its "
+                             f"{WALL_FIX}, not by plane")
 
 
 def _box_world(data, materials, walls, file):

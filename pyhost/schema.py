@@ -18,6 +18,7 @@ from plugins.conduction import CONTACT, GAP
 from plugins.convection import CORRELATIONS
 from plugins.drag import LAWS as DRAG_LAWS
 from plugins.heat import MODEL_NAMES
+from pyhost.engines.liggghts.names import CONDUCTION, CONDUCTION_FIX, COUPLING_FIX, MATERIAL_VALUES, WALL_FIX
 from pyhost.walls import FACES
 
 
@@ -66,7 +67,7 @@ class Effects:
                                     "moves the temperatures (and gives e), the others are side columns")
     heat_path: str = spec("in:exact,fast", "fast", "plugin evaluation path")
     restitution_feedback: bool = spec(default=False, doc="apply the model's e(v0) at contact end")
-    enduring_conduction: bool = spec(default=False, doc="box scenes: LIGGGHTS' fix heat/gran conducts through "
+    enduring_conduction: bool = spec(default=False, doc=f"box scenes: LIGGGHTS' {CONDUCTION_FIX} conducts through "
                                                          "particle contacts that outlast a collision, and those "
                                                          "with walls at a temperature")
     wall_heat: bool = spec(default=True, doc="collisions with walls at a fixed temperature exchange heat")
@@ -74,8 +75,8 @@ class Effects:
                                    "lasting conduction through particle-particle contacts, every "
                                    "conduction.every DEM steps (plugins/conduction/contact; settings in [conduction]); a collision's "
                                    "contact conducts only after its model duration t_coll, through its "
-                                   "collision heat before. Not with enduring_conduction or a script's fix "
-                                   "heat/gran, which conduct through the same contacts")
+                                   "collision heat before. Not with enduring_conduction or a script's "
+                                   f"{CONDUCTION_FIX}, which conduct through the same contacts")
     gap_conduction: str = spec("in:none," + ",".join(GAP), "none",
                                "conduction through the gas between particles near each other or touching "
                                "(particle-fluid-particle), every conduction.every DEM steps (plugins/conduction/gap; the gas "
@@ -110,7 +111,7 @@ class Material:
     heat_capacity: float = spec(">0", doc="[J/(kg K)]")
     conductivity: float = spec(">0", doc="[W/(m K)]")
     dem: DemContact | None = spec(default=None, doc="the DEM's softened contact: required for box scenes; a "
-                                                  "script scene reads it from the script's fix property/global "
+                                                  f"script scene reads it from the script's {MATERIAL_VALUES} "
                                                   "(checked against this table if given)")
     b1: float = spec(">0", 1.1, "mean pressure at first yield / Y [-]")
     b2: float = spec(">0", 2.8, "fully plastic mean pressure / Y [-]")
@@ -160,11 +161,11 @@ class Particles:
 class Wall:
     material: str = spec(doc="key of [materials]")
     plane: str = spec("in:," + ",".join(FACES), "", "which face of the box (box scenes)")
-    fix: str = spec(default="", doc="id of the script's fix wall/gran, primitive or mesh (script scenes)")
+    fix: str = spec(default="", doc=f"id of the script's {WALL_FIX}, primitive or mesh (script scenes)")
     temperature: float = spec(">=0", 0.0, "fixed temperature [K] (for collisions; with effects.convection also "
                                            "the gas at that side of a box scene); 0 means adiabatic; a script's "
-                                           "wall with a temperature for its fix heat/gran needs the same one here "
-                                           "(heat/gran's share during each collision is then taken back)")
+                                           f"wall with a temperature for its {CONDUCTION_FIX} needs the same one here "
+                                           f"({CONDUCTION}'s share during each collision is then taken back)")
 
 
 @dataclass(frozen=True)
@@ -252,13 +253,13 @@ class Dem:
 class Time:
     dem_step: float = spec(">=0", 0.0, "DEM time step [s] (box scenes; a script sets its own)")
     end: float = spec(">=0", 0.0, "simulated time [s] (box scenes; a script's runs set it, except a CFD-DEM "
-                                  "script's final 'run 0', which the coupling drives for this long, else for "
+                                  "script's final run of 0 steps, which the coupling drives for this long, else for "
                                   "the fluid case's controlDict endTime)")
     sample_every: int = spec(">0", 1, "DEM steps between harvests of the contact events with restitution "
                                       "feedback: a contact shorter than this gets its separation speed at the "
                                       "harvest, late (restitution_late in summary.json)")
     couple_every: int = spec(">0", 50, "DEM steps between fluid exchanges; a CFDEM case's couplingInterval "
-                                       "(its in-memory exchange, twoWayMPI), else its script's fix couple/cfd "
+                                       f"(its in-memory exchange, twoWayMPI), else its script's {COUPLING_FIX} "
                                        "couple_every, gives it when this key is absent")
     test_end: float = spec(">=0", 0.0, "simulated time of the -test smoke run [s]; 0 means end/10")
 

@@ -51,7 +51,7 @@ def expected_speed(scene) -> tuple[float, str]:
 
 
 def check_scene(scene) -> None:
-    from pyhost.dem_input import dem_collision_time, place_particles
+    from pyhost.engines.liggghts.box_input import dem_collision_time, place_particles
 
     file, d, tm = scene.path, scene.domain, scene.time
     if scene.fluid is not None and not scene.fluid.alpha_min < 1:

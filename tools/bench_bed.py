@@ -63,7 +63,7 @@ import numpy as np
 
 from bench_host import Clocked
 from pyhost.world import simulate, start_fluid
-from pyhost.dem_input import place_particles
+from pyhost.engines.liggghts.box_input import place_particles
 from pyhost.effects.fluid import layer_pressure_drop, upwards
 from pyhost.output import read_collisions
 from pyhost.scene import load_scene

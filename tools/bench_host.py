@@ -35,7 +35,7 @@ import time
 from pathlib import Path
 
 
-from pyhost.dem_input import input_lines, place_particles, write_data
+from pyhost.engines.liggghts.box_input import input_lines, place_particles, write_data
 from pyhost.scene import load_scene
 
 CASE = Path(__file__).resolve().parents[1] / "cases" / "hot-cold-box" / "case.toml"

@@ -14,9 +14,13 @@ import time
 from pathlib import Path
 
 from bench_host import heat_by_size
-from pyhost.dem import SceneDem  # the old code (a8d075d), run with PYTHONPATH at it
-from pyhost.dem_input import place_particles
-from pyhost.loop import Coupling
+
+try:        # the old code (a8d075d): its modules are gone from this tree, PYTHONPATH gives them
+    from pyhost.dem import SceneDem
+    from pyhost.dem_input import place_particles
+    from pyhost.loop import Coupling
+except ImportError as exc:
+    sys.exit(f"bench_host_baseline.py runs the code of commit a8d075d ({exc}): give PYTHONPATH=/path/to/that checkout")
 
 
 def run_host(scene, out: Path):

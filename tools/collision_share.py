@@ -29,7 +29,7 @@ import tomli_w
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from pyhost.dem_input import dem_collision_time  # noqa: E402
+from pyhost.engines.liggghts.box_input import dem_collision_time  # noqa: E402
 from plugins.bed import wen_yu_umf  # noqa: E402
 from pyhost.scene import load_scene  # noqa: E402
 

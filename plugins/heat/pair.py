@@ -88,10 +88,6 @@ class Pair:
         return dataclasses.replace(self, **changes)
 
     @property
-    def is_wall(self) -> bool:
-        return bool(np.all(np.isinf(self.R2)))
-
-    @property
     def log_constant(self):
         """The constant of ln() in eq. (8) actually used [-]."""
         return 3.0 * np.asarray(self.b1, dtype=float) if self.c_log is None else self.c_log

@@ -16,6 +16,7 @@ from plugins.heat.fast import REGIMES, collide_fast
 from plugins.heat.validity import check_scales
 from plugins.heat.validity import flags as validity_flags
 from pyhost.cli import UserError
+from pyhost.engines.liggghts.names import CONDUCTION
 
 HELP = "heat conducted and rebound of head-on collisions (models A, B, C; SI units)"
 
@@ -53,7 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dem-e", dest="dem_e", type=float, default=None,
                    help="the DEM's coefficient of restitution [-] (with --dem-Estar)")
     p.add_argument("--dem-Estar-original", dest="dem_Estar_original", type=float, default=None,
-                   help="heat/gran's original modulus [Pa] (softened_corrected); default --Estar")
+                   help=f"{CONDUCTION}'s original modulus [Pa] (softened_corrected); default --Estar")
 
 
 def pair_from_args(args) -> Pair:

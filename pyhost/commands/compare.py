@@ -125,7 +125,7 @@ def heat_by_model_offline(scene, collisions, models) -> dict:
     would have held (collisions with an adiabatic wall or capped ones carry no dT back).
     Box scenes only: particle ids are the order of ``place_particles``."""
     from plugins.heat.batch import evaluate
-    from pyhost.dem_input import material_index, place_particles
+    from pyhost.engines.liggghts.box_input import material_index, place_particles
 
     p = place_particles(scene)
     materials = list(scene.materials.values())

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from pyhost.effects import Effect, by_id
-from pyhost.script import ScriptError
+from pyhost.engines.liggghts.script import ScriptError
 
 TOLERANCE = 1e-9
 """Largest |energy_balance_error| of a completed run (relative to all that came in); round-off

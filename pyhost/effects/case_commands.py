@@ -16,7 +16,7 @@ from foamlib import FoamFile
 from pyhost.effects import Effect, by_id
 from pyhost.engines.cfdem_commands import SMALL, read_commands, write_times
 from pyhost.engines.fluid_case import start_time
-from pyhost.script import Command
+from pyhost.engines.liggghts.script import Command
 
 
 def case_commands(loop, driven: float | None):

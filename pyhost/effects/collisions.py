@@ -21,8 +21,7 @@ import dataclasses
 import numpy as np
 
 from plugins.dem.impulse import restitution_impulse
-from plugins.heat.batch import move_heat
-from pyhost.collisions import WALL_BASE, contact_keys
+from pyhost.collisions import Bodies, collide, contact_keys, ended_later, log_wall, material_of, minimum_image, wall_of
 from pyhost.effects import Effect
 from pyhost.effects.rank_heat import RankHeat, on_rank
 from pyhost.engines.atoms import Atoms
@@ -43,16 +42,6 @@ False: rank 0 moves all in time order (``harvest_partly`` between frames, else o
 the frame gathers), the reference tests/cases/test_mpi.py compares it with."""
 
 COLLISION_COLUMNS = ("time", "step", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
-
-
-def ended_later(begin, ends) -> np.ndarray:
-    """Whether each begun contact (BEGIN events) has an END among ``ends`` after its begin: a
-    contact shorter than the harvest interval."""
-    last = {}
-    for k, s in zip(contact_keys(ends["i"], ends["j"]).tolist(), ends["step"].tolist()):
-        last[k] = max(s, last.get(k, s))
-    return np.array([last.get(k, -1) > s for k, s in zip(contact_keys(begin["i"], begin["j"]).tolist(),
-                                                          begin["step"].tolist())], bool)
 
 
 class CollisionHeat(Effect):
@@ -100,6 +89,7 @@ class CollisionHeat(Effect):
         self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
         self.T_wall = np.array([w.temperature if self.loop.effects["wall_heat"] else np.nan for w in walls])
         self.wall_material = np.array([w.material for w in walls], int)
+        self.bodies = Bodies(self.loop.materials, self.loop.type_material, self.wall_material)
         heated = {(w.fix, w.mesh) for w, T in zip(walls, self.T_wall) if np.isfinite(T)}
         self.conducting = self.dem.event_walls(self.wall_index, heated)   # codes: heat/gran's share taken back
 
@@ -167,17 +157,16 @@ class CollisionHeat(Effect):
                   "extrapolation; such collisions are counted in summary.json as outside_model_range")
 
     def partners(self, atoms, i, j):
-        """For contacts between local atoms i and partners j (atom ids, or WALL_BASE + wall):
-        whether j is a wall, j as a local index or wall code, its material, radius [m] and mass
-        [kg] (inf for walls)."""
-        wall = j >= WALL_BASE
+        """For contacts between local atoms i and partners j (atom ids, or wall codes): j as a
+        local index or wall code, and both bodies (``pyhost.collisions.Partners``: materials,
+        radii [m], masses [kg] as LIGGGHTS has them)."""
+        wall, _ = wall_of(j)
         jl = np.where(wall, j, atoms.index(np.where(wall, 0, j)))
-        w = np.where(wall, j - WALL_BASE, 0)
         jj = np.where(wall, 0, jl)
-        mat_i = self.loop.materials_of(atoms.type[i])
-        wall_mat = np.where(self.wall_material[w] >= 0, self.wall_material[w], mat_i) if len(self.walls) else mat_i
-        mat = np.where(wall, wall_mat, self.loop.materials_of(atoms.type[jj]))
-        return wall, jl, mat, np.where(wall, np.inf, atoms.radius[jj]), np.where(wall, np.inf, atoms.mass[jj])
+        where, table = str(self.scene.path), self.bodies.type_material
+        return jl, self.bodies.partners(j, material_of(table, atoms.type[i], where), atoms.radius[i],
+                                        material_of(table, atoms.type[jj], where), atoms.radius[jj], atoms.mass[i],
+                                        atoms.mass[jj])
 
     def harvest_alone(self, due) -> bool:
         """Whether this chunk's end asks only for a harvest, under MPI with no fix heat/gran.
@@ -290,7 +279,7 @@ class CollisionHeat(Effect):
             return
         step, j = (np.concatenate([b[k] for b in batches]) for k in (1, 2))
         cols = {k: np.concatenate([b[0][k] for b in batches]) for k in batches[0][0]}
-        order = np.lexsort((j, cols["i"], j >= WALL_BASE, step))
+        order = np.lexsort((j, cols["i"], wall_of(j)[0], step))
         cols = {k: v[order] for k, v in cols.items()}
         self.record(cols)
         if self.loop.conduction is not None:
@@ -391,7 +380,7 @@ class CollisionHeat(Effect):
         share = np.clip(np.nan_to_num(steps)[:, None] - np.arange(window), 0.0, 1.0)
         share[np.arange(window) >= filled[:, None]] = 0.0
         q = dt * np.sum(flux * share, axis=1)              # heat heat/gran moved into i [J]
-        wall = j >= WALL_BASE
+        wall, _ = wall_of(j)
         a, b = atoms.index(i), np.where(wall, -1, atoms.index(np.where(wall, 0, j)))
         ok = np.isfinite(t_coll) & (a >= 0) & ((b >= 0) | wall) & (q != 0)
         on_wall = ok & wall
@@ -405,16 +394,16 @@ class CollisionHeat(Effect):
         self.totals["heat_gran_undone"] += float(np.abs(q).sum())
 
     def collide(self, atoms, ids_i, j, v0, step, T_begin=None) -> dict:
-        """Collisions of particles ``ids_i`` with partners ``j`` (ids, or WALL_BASE + wall) at
-        impact speeds v0 [m/s], begun at LIGGGHTS' step ``step`` of the run under way: the plugin's heat moved in this order
-        (``plugins.heat.batch.move_heat``). Returns their columns of the collision log (Q, e
+        """Collisions of particles ``ids_i`` with partners ``j`` (ids, or wall codes) at impact
+        speeds v0 [m/s], begun at LIGGGHTS' step ``step`` of the run under way: the plugin's heat
+        moved in this order (``pyhost.collisions.collide``). Returns their columns of the collision log (Q, e
         and t_coll zero without particle temperatures): ``record`` counts and writes them.
         ``T_begin`` (n, 2) [K]: the two temperatures when each began (NaN: as now), where
         something else (a fix heat/gran) changed them since: each collision's temperature
         difference is the one it began with, plus what earlier collisions of this batch moved."""
         i = atoms.index(ids_i)
-        wall, jl, mj, R_j, _ = self.partners(atoms, i, j)
-        mi, R_i = self.loop.materials_of(atoms.type[i]), atoms.radius[i]
+        jl, p = self.partners(atoms, i, j)
+        wall = p.wall
         models = self.scene.effects.heat_models
         heat = dict.fromkeys(("Q", "e", "t_coll"), np.zeros(len(i)))
         if self.loop.heat:
@@ -422,12 +411,12 @@ class CollisionHeat(Effect):
             if T_begin is not None:         # (T_i - T_j) then minus now, before this batch
                 drift = T_begin - np.column_stack([atoms.T[i], np.where(wall, np.nan, atoms.T[np.where(wall, i, jl)])])
                 shift = np.nan_to_num(drift[:, 0]) - np.where(wall, 0.0, np.nan_to_num(drift[:, 1]))
-            heat, flagged, capped = move_heat(models, self.scene.effects.heat_path, self.loop.materials, mi, mj, R_i,
-                                              R_j, v0, atoms.T, self.loop.C, i, jl, self.T_wall, shift)
+            heat, flagged, capped = collide(models, self.scene.effects.heat_path, self.bodies, p, v0, atoms.T,
+                                            self.loop.C, i, jl, self.T_wall, shift)
             self.totals["capped"] += capped
             if flagged.any():
                 self.flag_outside_range(int(flagged.sum()), float(np.max(v0[flagged])))
-        return dict(time=self.loop.time_of(step), step=step, i=ids_i, j=np.where(wall, 0, j), wall=np.where(wall, j - WALL_BASE + 1, 0), v0=v0,
+        return dict(time=self.loop.time_of(step), step=step, i=ids_i, j=np.where(wall, 0, j), wall=log_wall(j), v0=v0,
                     model=np.full(len(i), models[0] if models else "none"), **heat)
 
     def record(self, cols: dict) -> None:
@@ -457,19 +446,20 @@ class CollisionHeat(Effect):
 
     def impose_separation(self, atoms, ids_i, ids_j, normal, e, v0) -> int:
         """The model's separation speed e v0 [m/s] imposed now on each pair's normal velocity
-        (particles ``ids_i`` and ``ids_j``, or WALL_BASE + wall: the line of centres, nearest
+        (particles ``ids_i`` and ``ids_j``, or a wall code: the line of centres, nearest
         image; a wall's ``normal`` as given), momentum conserved; skipped where a particle is
         gone or e is NaN (contacts there at a restart: no collision). Returns how many e above
         1 were clipped."""
         i = atoms.index(ids_i)
         here = (i >= 0) & ~np.isnan(e)
-        wall, jl, _, _, m_j = self.partners(atoms, np.maximum(i, 0), ids_j)
+        jl, p = self.partners(atoms, np.maximum(i, 0), ids_j)
+        wall, m_j = p.wall, p.m_j
         here &= wall | (jl >= 0)
         normal = np.array(normal, float)
         jj = np.where(wall, 0, np.maximum(jl, 0))
         d = atoms.x[np.maximum(i, 0)] - atoms.x[jj]
         lo, hi, periodic = self.dem.box()
-        d = np.where(periodic, d - (hi - lo) * np.round(d / (hi - lo)), d)
+        d = minimum_image(d, hi - lo, periodic)
         normal[~wall] = d[~wall] / np.linalg.norm(d[~wall], axis=1)[:, None]
         v_j = np.where(wall[:, None], 0.0, atoms.v[jj])
         dv_i, dv_j, clipped = restitution_impulse(atoms.v[np.maximum(i, 0)], v_j, atoms.mass[np.maximum(i, 0)],

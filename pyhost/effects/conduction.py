@@ -31,7 +31,7 @@ from plugins.conduction import CONTACT, GAP, Gas, Pair, exchange
 from plugins.dem.hertz import effective_modulus
 from pyhost.collisions import contact_keys
 from pyhost.effects import Effect
-from pyhost.script import ScriptError
+from pyhost.engines.liggghts.script import ScriptError
 
 
 class LastingConduction(Effect):

@@ -33,8 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from plugins.heat.batch import move_heat
-from plugins.heat.exchange import WALL_BASE
+from pyhost.collisions import Bodies, collide, log_wall, material_of
 from pyhost.engines.events import BEGIN, END
 
 
@@ -83,8 +82,7 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     allgather = comm.allgather if comm is not None else (lambda mine: [mine])     # (serially: one rank)
     ev = events.take()
     ids, types, T, mass, radius = atoms.id, atoms.type, atoms.T, atoms.mass, atoms.radius
-    nt = len(setup.type_material)
-    material = np.where(types < nt, setup.type_material[np.minimum(types, nt - 1)], -1)
+    material = material_of(setup.type_material, types)
     wall, i, j = ev["wall"], ev["i"], ev["j"]
     j_atom = np.where(wall, i, j)
     top = int(max(ids.max(initial=0), i.max(initial=0), j_atom.max(initial=0))) + 1
@@ -136,17 +134,15 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
     a, b, w = li[go], lj[go], wall[go]
     # this rank's atoms, then the partners of other ranks: temperatures, capacities, radii, materials
     T_all, R_all, mat_all = np.r_[T, r_T], np.r_[radius, r_R], np.r_[material, r_mat]
-    C_all = np.r_[mass, r_m] * setup.capacity[np.maximum(mat_all, 0)]
+    m_all = np.r_[mass, r_m]
+    C_all = m_all * setup.capacity[np.maximum(mat_all, 0)]
     T_before = T.copy()
     result = dict(events=ev[out], still=len(still), capped=0, flagged=0, v_flagged=0.0, new=result_new)
-    code = j[go] - WALL_BASE
-    mi, mb = mat_all[a], mat_all[b]
-    wm = setup.wall_material[np.where(w, code, 0)] if len(setup.wall_material) else np.full(len(go), -1)
-    mj = np.where(w, np.where(wm >= 0, wm, mi), mb)
+    bodies = Bodies(setup.materials, setup.type_material, setup.wall_material)
+    p = bodies.partners(j[go], mat_all[a], R_all[a], mat_all[b], R_all[b], m_all[a], m_all[b])
     if len(go):
-        heat, flagged, capped = move_heat(setup.models, setup.path, setup.materials, mi, mj, R_all[a],
-                                          np.where(w, np.inf, R_all[b]), ev["vn"][go], T_all, C_all, a,
-                                          np.where(w, j[go], b), setup.T_wall, None)
+        heat, flagged, capped = collide(setup.models, setup.path, bodies, p, ev["vn"][go], T_all, C_all, a,
+                                        np.where(w, j[go], b), setup.T_wall, None)
         result.update(capped=capped, flagged=int(flagged.sum()),
                       v_flagged=float(ev["vn"][go][flagged].max(initial=0.0)))
     else:
@@ -166,6 +162,6 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
                   T_before=T_before[changed], T_after=T[changed].copy(), step=ev["step"][go], jj=j[go],
                   cols=dict(time=setup.clock[0] + (ev["step"][go] - setup.clock[1]) * setup.clock[2],
                             step=ev["step"][go], i=i[go], j=np.where(w, 0, j[go]),
-                            wall=np.where(w, code + 1, 0), v0=ev["vn"][go],
+                            wall=log_wall(j[go]), v0=ev["vn"][go],
                             model=np.full(len(go), setup.models[0]), **heat))
     return result

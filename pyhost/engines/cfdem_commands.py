@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pyhost.engines.fluid_case import cfdem_dict, entry_line
-from pyhost.script import host_fix_refusal
+from pyhost.engines.liggghts.script import host_fix_refusal
 
 SMALL = 1e-15
 """OpenFOAM's SMALL, which CFDEM adds before each floor of a time over the coupling interval."""

@@ -1,6 +1,6 @@
 """The DEM of a scene on the LIGGGHTS bridge (``pyhost.engines.liggghts``): a LIGGGHTS script run
 command by command, either the user's own (``[dem] script``) or the box world the host
-generates from the scene (``pyhost.dem_input``). Both go through the same class.
+generates from the scene (``pyhost.engines.liggghts.box_input``). Both go through the same class.
 
 What the coupling loop gets from it, each in LIGGGHTS' local order and valid until the next
 ``run``: ``atoms()`` (ids, positions, velocities, radii, masses, types and the writable
@@ -23,13 +23,13 @@ from pathlib import Path
 
 import numpy as np
 
-from pyhost.collisions import WALL_BASE
+from pyhost.collisions import wall_code
 from pyhost.engines.atoms import Atoms, local_view
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
 from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_snapshot, local_values, put_by_id, set_random_states, write_local)
-from pyhost.script import Command, ScriptError, ScriptInfo, output_files
+from pyhost.engines.liggghts.script import Command, ScriptError, ScriptInfo, output_files
 
 FLUID_FIX = "collheat_fluid"
 HEAT_GRAN_WINDOW = 200
@@ -497,9 +497,14 @@ class Dem:
             raise OSError(errno.EIO, f"LIGGGHTS wrote a restart it cannot read back, a full disk? ({exc})",
                           str(path)) from None
 
-    def engine_command(self, line: str) -> None:
-        """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""
-        self._raw(line)
+    def drop_lost(self) -> None:
+        """A set-up now, on every rank, after which the particles past a fixed face of the box
+        are gone (LIGGGHTS drops them at a re-neighbouring: 'thermo_modify lost ignore')."""
+        self._raw("run 0 post no")
+
+    def write_restart(self, path) -> None:
+        """LIGGGHTS' restart file written at ``path``, on every rank."""
+        self._raw(f"write_restart {path}")
 
     def add_velocity(self, local_index, dv) -> None:
         """Add dv [m/s] to the velocity of these atoms (indices into the last ``atoms()``)."""
@@ -563,11 +568,11 @@ class Dem:
             self._pending = None
             self.log("the host's contact recorder (fix collheat_events) given anew after the script's walls "
                      "defined since the first run: it sums heat/gran's flux through their contacts after they add it")
-        primitive = [(fix, WALL_BASE + wall_index[fix, 0]) for fix, w in self.info.walls.items() if w.primitive is not None]
+        primitive = [(fix, int(wall_code(wall_index[fix, 0]))) for fix, w in self.info.walls.items() if w.primitive is not None]
         if not self.events.primitives(*(zip(*primitive) if primitive else ([], []))):
             raise ScriptError(f"the primitive walls {', '.join(f for f, _ in primitive)}: one is not a fix wall/gran "
                               "with a primitive wall the contact recorder can read: their collisions cannot be seen")
-        meshes = [(mesh, WALL_BASE + wall_index[fix, k]) for fix, w in self.info.walls.items()
+        meshes = [(mesh, int(wall_code(wall_index[fix, k]))) for fix, w in self.info.walls.items()
                   for k, mesh in enumerate(w.meshes or ())]
         if not self.events.meshes(*(zip(*meshes) if meshes else ([], []))):
             names = ", ".join(sorted({m for m, _ in meshes}))
@@ -588,7 +593,7 @@ class Dem:
                                ("overlap", "constant", "projection").index(mode) if mode in ("constant", "projection")
                                else 0, self.value(area) if mode == "constant" and T is not None else 0.0))
                 if T is not None:
-                    conducting.add(WALL_BASE + wall_index[fix, k])
+                    conducting.add(int(wall_code(wall_index[fix, k])))
             if not self.events.wall_conduction(meshes, params):
                 raise ScriptError(f"walls {', '.join(f for f, _ in walls)}: the contact recorder cannot follow "
                                   "heat/gran's conduction through them (an atom type out of range?)")

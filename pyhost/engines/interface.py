@@ -1,12 +1,15 @@
 """What the loop, its effects and the checkpoints ask of a DEM engine: the whole interface a
-second engine implements in one file (as ``pyhost.engines.dem.Dem`` does for LIGGGHTS 3.8;
-LAMMPS' GRANULAR package, LIGGGHTS' maintained successor, is the likely next one).
+second engine's bridge implements (as ``pyhost.engines.dem.Dem`` does for LIGGGHTS 3.8, with
+the package ``pyhost.engines.liggghts``; LAMMPS' GRANULAR package, LIGGGHTS' maintained
+successor, is the likely next one).
 
 The engine runs a script command by command (the host's commands among them), advances in
 chunks of steps, and hands out the particles (``Atoms``) with writable temperatures. Contacts
 come as events recorded inside the engine at every step (``events``: the recorder of
-``pyhost.engines.events``). SI units throughout. ``tests/unit/test_structure.py`` checks that the loop and
-the effects use nothing of the engine outside this interface, and that ``Dem`` has all of it.
+``pyhost.engines.events``; ``ContactEvents``) and what the script declared so far is its
+``info`` (``ScriptInfo``). SI units throughout. ``tests/unit/test_structure.py`` checks that the
+loop and the effects use nothing of the engine, its events or its info outside this interface,
+and that LIGGGHTS' bridge has all of it.
 """
 from __future__ import annotations
 
@@ -15,12 +18,55 @@ from typing import Protocol
 import numpy as np
 
 
+class ContactEvents(Protocol):
+    """The contact events recorded inside the engine at every step (``pyhost.engines.events``:
+    ``ContactEvents``, under MPI ``RankEvents``): each contact's begin (with its impact speed)
+    and end, taken at the host's harvests."""
+
+    window: int                  # steps of a fix heat/gran's flux kept per new contact (0: none)
+    joined: list                 # contacts that moved between MPI ranks, at the last take
+
+    @property
+    def waiting(self) -> int:
+        """Events recorded and not yet taken."""
+
+    def take(self) -> np.ndarray:
+        """The events waiting, oldest first (``pyhost.engines.events.EVENT``); forgotten then."""
+
+    def sync(self) -> None:
+        """Record the contacts now, between runs (after a set-up)."""
+
+    def appeared(self) -> tuple:
+        """Atoms inserted since the last call: ids, temperature [K] at their first step, that step."""
+
+    def histories(self, all: bool = False) -> tuple:
+        """The flux histories of new contacts handed over: i, j, begin step, steps kept, fluxes [W]."""
+
+    def restitution(self, keys, speed, normal) -> None:
+        """Separation speeds [m/s] along ``normal`` to impose when these open contacts end."""
+
+    def forget(self, keys) -> None:
+        """Drop the separation speeds of these contacts."""
+
+
+class ScriptInfo(Protocol):
+    """What the script declared so far, as the host reads it (``pyhost.engines.liggghts.script.ScriptInfo``)."""
+
+    heat_gran: str | None        # id of the script's conduction fix (heat/gran), None: none
+    globals: dict                # name of a per-type material property -> the id of the command that sets it
+    fixes: dict                  # id -> the command that defined it (defined now)
+    streams: list                # ids of the insertions that stream particles in, defined now
+
+    def fix_named(self, message: str):
+        """The script's command that an engine error message names, or None."""
+
+
 class DemEngine(Protocol):
     """A DEM engine as the host drives it."""
 
     # -- state -------------------------------------------------------------------------
-    info: object                 # what the script declared so far (pyhost.script.ScriptInfo): walls, heat/gran, computes
-    events: object | None        # the contact event recorder (pyhost.engines.events), None: no contacts asked for
+    info: ScriptInfo             # what the script declared so far: walls, heat/gran, computes
+    events: ContactEvents | None  # the contact event recorder, None: no contacts asked for
     link: object | None          # the other MPI ranks (pyhost.engines.ranks.Link), None when serial
 
     @property
@@ -43,8 +89,12 @@ class DemEngine(Protocol):
         each named in the engine's errors (an engine that checks each command before running
         it may check them together first)."""
 
-    def engine_command(self, line: str) -> None:
-        """Run a command of the host's own (write_restart, ...)."""
+    def drop_lost(self) -> None:
+        """A set-up now, after which the particles past a fixed face of the box are gone (a
+        checkpoint's restart file then holds what the host's state does)."""
+
+    def write_restart(self, path) -> None:
+        """Write the engine's restart file at ``path`` (a checkpoint's)."""
 
     def check_restart(self, path) -> None:
         """The engine's restart file just written at ``path`` is whole (read back): OSError
@@ -161,5 +211,12 @@ class DemEngine(Protocol):
         """Set each insertion's progress."""
 
 
-MEMBERS = tuple(sorted({n for n in vars(DemEngine) if not n.startswith("_")} | set(DemEngine.__annotations__)))
+def members(protocol) -> tuple:
+    """Every name a protocol declares."""
+    return tuple(sorted({n for n in vars(protocol) if not n.startswith("_")} | set(protocol.__annotations__)))
+
+
+MEMBERS = members(DemEngine)
 """Every name of the interface."""
+EVENT_MEMBERS = members(ContactEvents)
+INFO_MEMBERS = members(ScriptInfo)

@@ -71,8 +71,8 @@ from pathlib import Path
 import numpy as np
 from pyhost.engines.liggghts import Liggghts
 from pyhost.scene import load_scene
-from pyhost.script import read_script
-from pyhost.world import box_world
+from pyhost.engines.liggghts.script import read_script
+from pyhost.engines.liggghts.worlds import box_world
 case, out = Path(sys.argv[1]), Path(sys.argv[2])
 scene = load_scene(case)
 scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, end=scene.time.test_end))

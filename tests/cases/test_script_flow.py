@@ -1,4 +1,4 @@
-"""A script's control flow run as LIGGGHTS' own input loop runs it (pyhost.script.Program):
+"""A script's control flow run as LIGGGHTS' own input loop runs it (pyhost.engines.liggghts.script.Program):
 label/jump loops over 'next' variables, a loop left by an 'if' that jumps out, an 'if' with
 runs in its branches, a jump to another file, 'run N every M' and 'quit'. Each is compared
 with plain 'liggghts -in' on the same script: the same steps, and its dump file byte for byte;

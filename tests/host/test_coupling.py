@@ -37,10 +37,10 @@ def test_isothermal_scene_adds_and_samples_nothing(tmp_path):
 REFERENCE = """
 import json, sys
 from pathlib import Path
-from pyhost.world import box_world
+from pyhost.engines.liggghts.worlds import box_world
 from pyhost.engines.dem import Dem
 from pyhost.scene import load_scene
-from pyhost.script import Command, read_script
+from pyhost.engines.liggghts.script import Command, read_script
 case = Path(sys.argv[1])
 script, _ = box_world(load_scene(case), case.parent / "ref")
 dem = Dem(case.parent / "ref" / "dem")
@@ -122,7 +122,7 @@ def restart_run(workdir, touching: bool) -> list:
     import dataclasses
 
     from pyhost.world import simulate
-    from pyhost.dem_input import place_particles
+    from pyhost.engines.liggghts.box_input import place_particles
 
     case = Path(workdir) / "case.toml"
     case.write_text(TWO)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from conftest import steel_toml
 
-from pyhost.dem_input import input_lines, place_particles, write_data
+from pyhost.engines.liggghts.box_input import input_lines, place_particles, write_data
 from pyhost.scene import SceneError, load_scene
 
 pytestmark = pytest.mark.engines

@@ -11,7 +11,7 @@ import pytest
 from conftest import steel_toml
 import pyvista
 
-from pyhost.post import load_post_scene
+from pyhost.scene import load_post_scene
 from pyhost.scene import SceneError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -452,3 +452,23 @@ def test_contact_dumps_written_per_processor_are_read(tmp_path):
     print(summary["collisions"], pairs, walls)
     assert summary["complete"] is True and summary["particles"] == 60
     assert summary["collisions"] == {"particle_particle": pairs, "particle_wall": walls} and pairs > 50
+
+
+def test_the_heat_path_is_the_runs_choice(tmp_path):
+    """--heat-path exact evaluates the models by the exact path, as a run's effects.heat_path
+    does (post used the tables only): the pair's heat agrees with the tables' to their stated
+    accuracy (3.1e-9 at most, README's benchmark), and is not the tables' number itself."""
+    hot_and_cold(tmp_path, hot_from=10)
+    Q = {}
+    for path in ("fast", "exact"):
+        r = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--heat-path", path,
+                 "--out", tmp_path / path)
+        assert r.returncode == 0, r.stderr
+        [row] = rows(tmp_path / path)
+        Q[path] = np.array([float(row[f"Q_{m}"]) for m in "ABC"])
+    assert np.all(Q["fast"] > 0)
+    assert Q["exact"] == pytest.approx(Q["fast"], rel=1e-8)
+    assert np.any(Q["exact"] != Q["fast"])
+    bad = post(tmp_path / "run.dump", "--scene", tmp_path / "scene.toml", "--dt", "1e-6", "--heat-path", "table",
+               "--out", tmp_path / "bad")
+    assert bad.returncode == 2 and "--heat-path" in bad.stderr and "exact" in bad.stderr

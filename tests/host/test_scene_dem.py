@@ -19,10 +19,10 @@ SCRIPT = """
 import json, sys
 import numpy as np
 from pathlib import Path
-from pyhost.world import box_world
+from pyhost.engines.liggghts.worlds import box_world
 from pyhost.engines.dem import FLUID_FIX, Dem
 from pyhost.scene import load_scene
-from pyhost.script import read_script
+from pyhost.engines.liggghts.script import read_script
 scene = load_scene(sys.argv[1])
 g, dt = np.array(scene.domain.gravity), scene.time.dem_step
 result = []

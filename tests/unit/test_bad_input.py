@@ -68,7 +68,7 @@ def test_cli_bad_input_one_line_exit_2(args, word):
 ])
 def test_script_commands_the_host_cannot_couple_are_refused_when_read(tmp_path, line, message):
     """Found when the script is read, before any engine time, wherever they stand."""
-    from pyhost.script import ScriptError, read_script
+    from pyhost.engines.liggghts.script import ScriptError, read_script
 
     (tmp_path / "in.x").write_text(f"variable a equal 2\nrun 10\n{line}\n")
     with pytest.raises(ScriptError, match=rf"in.x:3: .*{message}"):
@@ -79,7 +79,7 @@ def test_delete_atoms_keeping_the_ids_is_read(tmp_path):
     """``delete_atoms ... compress no`` keeps the ids the host follows each particle by (a
     pour on two ranks with it: the balance's terms are those of the deleted particles,
     docs/liggghts-tutorials.md)."""
-    from pyhost.script import read_script
+    from pyhost.engines.liggghts.script import read_script
 
     (tmp_path / "in.x").write_text("run 10\ndelete_atoms region out compress no\nrun 10\n")
     assert [c.text for c in read_script(tmp_path / "in.x")] == ["run 10", "delete_atoms region out compress no",
@@ -90,7 +90,7 @@ def test_a_primitive_wall_placed_by_a_variable_is_read():
     """Debian's hydrogel tutorial places its walls at ${sizeX}: LIGGGHTS has the geometry (the
     contact recorder reads it from the fix), the host needs only the wall's kind and type; it
     used to refuse the script ("primitive wall the host cannot read")."""
-    from pyhost.script import Command, ScriptError, parse_wall
+    from pyhost.engines.liggghts.script import Command, ScriptError, parse_wall
 
     wall = parse_wall(Command("fix wall_right all wall/gran model hertz tangential history primitive type 2 "
                               "xplane ${sizeX}", "in.x", 5))
@@ -107,7 +107,7 @@ def test_a_script_walls_temperature_is_read_as_written():
     """The temperature a script gives a wall for its fix heat/gran: a primitive wall/gran's
     'temperature' keyword, a mesh's in its fix mesh/surface (a number or a $variable, as
     written); a wall without one has none; an unfixed wall is gone."""
-    from pyhost.script import Command, ScriptInfo
+    from pyhost.engines.liggghts.script import Command, ScriptInfo
 
     info = ScriptInfo()
     for n, line in enumerate(["fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0 "
@@ -138,6 +138,6 @@ def test_a_scripts_output_files_are_found(line, files):
     """The files a LIGGGHTS command opens without making their folder (settlingTestMPI's fix
     print into DEM/post: the host makes it), read from each command's words in LIGGGHTS'
     order; dumps and write_restart are left out, LIGGGHTS makes their folders itself."""
-    from pyhost.script import Command, output_files
+    from pyhost.engines.liggghts.script import Command, output_files
 
     assert output_files(Command(line, "in.test", 1)) == files

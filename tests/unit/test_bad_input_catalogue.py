@@ -424,7 +424,7 @@ WRITERS = {  # id: (the writing, in a process whose files may not exceed 300 byt
     "the .pvd index": ("s = VtkSeries(out / 'vtk', 'particles'); s.frames = [(k * 0.1, f'f{k}.vtu') for k in range(20)]\n"
                        "s.flush()", "vtk/particles.pvd"),
     "a CSV log's header": ("CsvLog(out / 'history.csv', tuple(f'column_{k}' for k in range(40)))", "history.csv"),
-    "the DEM's particle data": ("from pyhost.dem_input import place_particles, write_data\n"
+    "the DEM's particle data": ("from pyhost.engines.liggghts.box_input import place_particles, write_data\n"
                                 "from pyhost.scene import load_scene\n"
                                 "scene = load_scene(out.parent / 'case' / 'case.toml')\n"
                                 "write_data(out / 'particles.data', scene, place_particles(scene))", "particles.data"),

@@ -137,3 +137,39 @@ def test_heat_exchange_in_rounds_is_bit_identical_to_one_by_one(seed):
     got = exchange_heat(T, C, i, j, G, T_wall)
     assert np.array_equal(T, T_ref) and np.array_equal(got[0], ref[0])
     assert got[1] == ref[1] and got[2] == ref[2] and str(got[2]) == str(ref[2])
+
+
+def test_the_bodies_of_collisions_with_particles_and_walls():
+    """One lookup for the run, each rank and post: a wall is infinitely large and heavy, made
+    of its own material or, where it has none (-1), of the particle's; a particle partner's
+    material from its atom type; spheres' masses 4/3 pi R^3 rho where the engine gives none;
+    the log numbers walls from 1 (post: by its [[walls]] entry) and particles 0."""
+    from types import SimpleNamespace
+
+    from pyhost.collisions import Bodies, log_wall, material_of, wall_code
+
+    glass, steel = SimpleNamespace(density=2500.0), SimpleNamespace(density=7800.0)
+    bodies = Bodies([glass, steel], np.array([-1, 0, 1]), np.array([1, -1]))
+    j = np.array([7, int(wall_code(0)), int(wall_code(1))])
+    mat_i = material_of(bodies.type_material, np.array([1, 2, 2]))
+    p = bodies.partners(j, mat_i, np.full(3, 1e-3), material_of(bodies.type_material, np.array([2, 0, 0])),
+                        np.full(3, 2e-3))
+    assert p.wall.tolist() == [False, True, True] and p.w.tolist() == [0, 0, 1]
+    assert p.mat_i.tolist() == [0, 1, 1] and p.mat_j.tolist() == [1, 1, 1]      # wall 1 takes the particle's steel
+    assert np.isinf(p.R_j[1:]).all() and np.isinf(p.m_j[1:]).all()
+    assert p.m_i[0] == pytest.approx(4 / 3 * np.pi * 1e-9 * 2500.0, rel=1e-15)
+    assert p.m_j[0] == pytest.approx(4 / 3 * np.pi * 8e-9 * 7800.0, rel=1e-15)
+    assert log_wall(j).tolist() == [0, 1, 2] and log_wall(j, [4, 2]).tolist() == [0, 5, 3]
+    assert material_of(bodies.type_material, [5]).tolist() == [-1]
+    with pytest.raises(ValueError, match=r"case.toml: atom type\(s\) \[0, 5\] have no material"):
+        material_of(bodies.type_material, [1, 0, 5], "case.toml")
+
+
+def test_the_minimum_image_only_along_periodic_axes():
+    """A separation of 0.9 L along a periodic axis is -0.1 L to the nearest image; along a
+    fixed axis it stays (box 1 m x 2 m x 4 m, periodic in x and z)."""
+    from pyhost.collisions import minimum_image
+
+    d = minimum_image(np.array([[0.9, 1.8, 3.6], [-0.4, -1.9, -2.1]]), np.array([1.0, 2.0, 4.0]),
+                      np.array([True, False, True]))
+    assert d == pytest.approx(np.array([[-0.1, 1.8, -0.4], [-0.4, -1.9, 1.9]]), abs=1e-15)

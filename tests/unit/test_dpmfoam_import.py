@@ -16,7 +16,7 @@ from plugins.dem.hertz import DemHertz, effective_modulus, hertz_collision_time,
 from pyhost.engines.dpmfoam_case import DpmfoamError, convert, read_cloud
 from pyhost.schema import SceneError
 from pyhost.scene import load_scene
-from pyhost.world import user_script
+from pyhost.engines.liggghts.worlds import user_script
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
 from dpmfoam_as_is import GLASS as MATERIAL  # noqa: E402  (the five real-material keys a user adds)

@@ -6,7 +6,9 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from pyhost.dumps import Compute, DumpError, DumpReader, parse_compute, read_script, setup_variables
+from pyhost.dumps import DumpError, DumpReader
+from pyhost.engines.liggghts.computes import Compute, parse_compute
+from pyhost.engines.liggghts.dump_script import read_script, setup_variables
 
 ALL = ("id", "type", "position", "velocity", "radius")
 STEPS = list(range(0, 6001, 500))
@@ -251,7 +253,8 @@ def test_the_scripts_dem_values_give_each_materials_dem_contact(tmp_path):
     """post's DEM contact of each material from the script's fix property/global (per type, the
     restitution per type pair read at (t, t)); the primitive wall's material from its type; a
     value given as a variable cannot be read, and the refusal says so and where."""
-    from pyhost.post import Post, load_post_scene
+    from pyhost.post import Post
+    from pyhost.scene import load_post_scene
 
     material = ("density = 2500.0\nyoungs_modulus = 63e9\npoisson_ratio = 0.22\nyield_stress = 500e6\n"
                 "heat_capacity = 800.0\nconductivity = 1.0\n")
@@ -313,7 +316,7 @@ def test_which_variables_posts_set_up_evaluates_as_the_run_does():
 
 
 def test_an_included_file_is_read_in_its_place(tmp_path):
-    """post reads a script as the run does (pyhost.script.script_commands): an included file's
+    """post reads a script as the run does (pyhost.engines.liggghts.script.script_commands): an included file's
     commands in their place, named by their own file and line; before, post warned 'include
     ... not followed' and missed the included property/globals and runs."""
     (tmp_path / "in.materials").write_text("fix m1 all property/global youngsModulus peratomtype 5e6\n"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import tomli_w
 
-from pyhost.dem_input import dem_collision_time
+from pyhost.engines.liggghts.box_input import dem_collision_time
 from pyhost.failures import likely_cause
 from pyhost.scene import load_scene
 

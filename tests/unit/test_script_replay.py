@@ -1,10 +1,10 @@
-"""The set-up a restarted script replays (pyhost.script.replay): pure logic on a script's
+"""The set-up a restarted script replays (pyhost.engines.liggghts.script.replay): pure logic on a script's
 commands, no engine."""
 from pathlib import Path
 
 import pytest
 
-from pyhost.script import ScriptError, read_script, replay
+from pyhost.engines.liggghts.script import ScriptError, read_script, replay
 
 SCRIPT = """\
 variable n index 100
@@ -66,7 +66,7 @@ def test_program_follows_loops_jumps_and_includes_as_liggghts_input_loop(tmp_pat
     exhausted at the third pass, which skips one jump), an include is read in its place, a
     jump inside an 'if' branch drops the branch's other commands, a missing label is named;
     state() and restore() carry the position and the trace."""
-    from pyhost.script import Program
+    from pyhost.engines.liggghts.script import Program
 
     (tmp_path / "in.inc").write_text("print inc\n")
     (tmp_path / "in.loop").write_text("variable i loop 3\nlabel top\nrun 10\nnext i\njump SELF top\n"
@@ -101,10 +101,10 @@ def test_a_script_without_a_box_before_the_run_is_refused(tmp_path):
 
 
 def test_the_files_a_script_reads_are_its_inputs_and_not_those_it_writes(tmp_path):
-    """What a restart fingerprints besides the script (pyhost.script.input_files): the STL of a
+    """What a restart fingerprints besides the script (pyhost.engines.liggghts.script.input_files): the STL of a
     mesh (its 'file' keyword is read, a fix print's is written), a read_data file; not a dump,
     nor a restart file the script writes and reads back, nor a word that only looks like a file."""
-    from pyhost.script import input_files
+    from pyhost.engines.liggghts.script import input_files
 
     (tmp_path / "meshes").mkdir()
     for name in ("meshes/wall.stl", "beads.data", "bed.restart", "out.dump", "printed.txt"):

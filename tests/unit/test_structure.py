@@ -3,6 +3,7 @@ pyhost/ nothing of tools/ (scripts that import pyhost), and no module of either 
 itself again through its imports, counting those inside functions."""
 import ast
 import re
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -166,3 +167,88 @@ def test_each_total_is_declared_once_by_the_effect_that_adds_to_it():
               for n, line in enumerate(f.read_text().splitlines(), 1)
               if re.search(r"totals\.get\(|totals\.setdefault\(", line)]
     assert around == [], around
+
+
+# -- issue 45: the engine's syntax in its bridge, one collision pipeline, a small post -----------------
+
+ENGINE_WORDS = re.compile(r"\bfix\s+\S+\s+\S+\s+\S|\bunfix\s+\S|pair_style|pair_coeff|create_box|create_atoms|"
+                          r"atom_style|atom_modify|read_restart|write_restart|read_data|neigh_modify|wall/gran|"
+                          r"heat/gran|property/global|property/atom|mesh/surface|insert/(pack|stream|rate)|"
+                          r"particletemplate|particledistribution|nve/sphere|couple/cfd|f_Temp|dump_modify|"
+                          r"communicate\s+single|\btimestep\s+[0-9$]|\brun\s+[0-9$]|\bdump\s+\S+\s+\S+\s+(custom|local|atom)")
+"""LIGGGHTS' commands as they appear in a script (the figure of ../shared/tools/structure_figures.py)."""
+
+
+def engine_syntax_lines(f: Path) -> int:
+    """String literals of a file (not docstrings) with LIGGGHTS syntax in them."""
+    import io
+    import tokenize
+
+    toks = [t for t in tokenize.generate_tokens(io.StringIO(f.read_text()).readline)]
+    count, seen = 0, []
+    for t in toks:
+        if t.type == tokenize.STRING:
+            docstring = not seen or (seen[-1].type == tokenize.OP and seen[-1].string == ":")
+            if not docstring and ENGINE_WORDS.search(t.string):
+                count += 1
+        if t.type not in (tokenize.NL, tokenize.NEWLINE, tokenize.COMMENT, tokenize.INDENT, tokenize.DEDENT):
+            seen.append(t)
+    return count
+
+
+def test_liggghts_syntax_stays_in_its_bridge():
+    """At most 20 string literals with LIGGGHTS syntax in pyhost/ outside pyhost/engines/, in at
+    most 5 files (112 in 14 files before issue 45); the box world's input alone has dozens."""
+    found = {str(f.relative_to(ROOT)): n for f in sorted((ROOT / "pyhost").rglob("*.py"))
+             if "engines" not in f.relative_to(ROOT).parts and (n := engine_syntax_lines(f))}
+    assert engine_syntax_lines(ROOT / "pyhost" / "engines" / "liggghts" / "box_input.py") > 10   # (the scan sees them)
+    assert sum(found.values()) <= 20 and len(found) <= 5, found
+
+
+def test_post_is_the_pipeline_fed_from_dumps():
+    """post.py at most 450 lines (734 before issue 45): the pipeline's pieces (sphere mass, wall
+    codes, minimum-image rounding) live in pyhost/collisions.py only, not in post, the run's
+    collision effect or the per-rank path."""
+    assert len((ROOT / "pyhost" / "post.py").read_text().splitlines()) <= 450
+    piece = re.compile(r"4\.?0?\s*/\s*3\.?0?\s*\*\s*(np\.|math\.)pi|WALL_BASE\s*\+|np\.round\(d\s*/")
+    assert len(piece.findall((ROOT / "pyhost" / "collisions.py").read_text())) >= 2      # (the scan sees them)
+    copies = {f: len(piece.findall((ROOT / f).read_text()))
+              for f in ("pyhost/post.py", "pyhost/effects/collisions.py", "pyhost/effects/rank_heat.py",
+                        "pyhost/contacts.py", "pyhost/engines/dem.py", "pyhost/engines/liggghts/box_input.py")}
+    assert {f: n for f, n in copies.items() if n} == {}
+    assert "heat_path" in (ROOT / "pyhost" / "post.py").read_text()      # post takes any heat path, not "fast" alone
+
+
+def uses_of(f: Path, holder: str) -> set:
+    """Attributes the file takes of the engine's ``holder`` (``events`` or ``info``): ``X.dem.holder.NAME``
+    or ``dem.holder.NAME``."""
+    used = set()
+    for node in ast.walk(ast.parse(f.read_text())):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute) and node.value.attr == holder:
+            base = node.value.value
+            if isinstance(base, ast.Name) and base.id == "dem" or isinstance(base, ast.Attribute) and base.attr == "dem":
+                used.add(node.attr)
+    return used
+
+
+def test_the_engines_events_and_info_are_protocols_of_what_the_host_uses():
+    """The loop, its effects and the checkpoints use of ``dem.events`` and ``dem.info`` only
+    what pyhost.engines.interface declares (ContactEvents, ScriptInfo), and LIGGGHTS' bridge
+    has all of it (the recorder serially and under MPI, the script's info)."""
+    from pyhost.engines.events import ContactEvents, RankEvents
+    from pyhost.engines.interface import EVENT_MEMBERS, INFO_MEMBERS
+    from pyhost.engines.liggghts.script import ScriptInfo
+
+    files = [ROOT / "pyhost" / "loop.py", ROOT / "pyhost" / "checkpoint.py",
+             *sorted((ROOT / "pyhost" / "effects").glob("*.py"))]
+    events = set().union(*(uses_of(f, "events") for f in files))
+    info = set().union(*(uses_of(f, "info") for f in files))
+    assert {"take", "window", "restitution"} <= events and "heat_gran" in info       # (the scan sees them)
+    assert sorted(events - set(EVENT_MEMBERS)) == [] and sorted(info - set(INFO_MEMBERS)) == []
+    assert len(EVENT_MEMBERS) == 9
+    for cls in (ContactEvents, RankEvents):
+        source = ast.unparse(ast.parse(Path(sys.modules[cls.__module__].__file__).read_text()))
+        missing = [m for m in EVENT_MEMBERS if not hasattr(cls, m) and f"self.{m}" not in source]
+        assert missing == [], (cls.__name__, missing)
+    script_info = ScriptInfo()
+    assert [m for m in INFO_MEMBERS if not hasattr(script_info, m)] == []

@@ -498,6 +498,35 @@ def parse_run(cmd: Command) -> RunCommand:
     return RunCommand(words[1], upto, pre=pre)
 
 
+def step_after(cmd: Command, step: int | None) -> int | None:
+    """The step a ``run N [upto]``, ``reset_timestep N`` or ``read_restart`` leaves the
+    script at, from ``step`` before it, counted as written (None: unknown: a $variable, a
+    restart file's step); ``step`` for any other command."""
+    words = cmd.text.split()
+    if words[0] not in ("run", "reset_timestep", "read_restart"):
+        return step
+    n = int(words[1]) if len(words) > 1 and words[1].isdigit() and words[0] != "read_restart" else None
+    if n is None:
+        return None
+    return n if words[0] == "reset_timestep" or "upto" in words[2:] else None if step is None else step + n
+
+
+def sets_temperature(cmd: Command) -> bool:
+    """Whether the command is a ``set ... property/atom Temp VALUE``."""
+    words = cmd.text.split()
+    return words[0] == "set" and "property/atom" in words[:-2] and words[words.index("property/atom") + 1] == "Temp"
+
+
+def script_couple_every(script: Path) -> tuple[int, str] | None:
+    """``couple_every N`` of a CFDEM script's ``fix ID GROUP couple/cfd`` (the script's own text,
+    not its includes) and where it is, or None."""
+    for k, line in enumerate(script.read_text(errors="replace").splitlines(), 1):
+        m = re.match(r"\s*fix\s+\S+\s+\S+\s+couple/cfd\b.*?\bcouple_every\s+(\d+)\b", line.split("#")[0])
+        if m:
+            return int(m.group(1)), f"{script}:{k}"
+    return None
+
+
 def output_files(cmd: Command) -> list[str]:
     """The files a command makes LIGGGHTS open without making their folder, as the script
     names them (relative to where the script runs; ``$`` variables unresolved): a fix's
@@ -626,6 +655,12 @@ class ScriptInfo:
     streams: list = field(default_factory=list)         # ids of the fix insert/stream defined now
     randoms: list = field(default_factory=list)         # "what id" of insertion's random generators
     fixes: dict = field(default_factory=dict)           # fix id -> the Command that defined it (defined now)
+    # what post reads of the script that wrote the dumps (pyhost.engines.liggghts.dump_script), over the whole script
+    timestep: str | None = None                         # the last 'timestep', as written
+    computes: dict = field(default_factory=dict)        # compute id -> the Command that defined it
+    global_values: dict = field(default_factory=dict)   # property/global name -> the Command that sets it
+    conductions: list = field(default_factory=list)     # ids of every fix heat/gran defined, in order
+    walls_defined: list = field(default_factory=list)   # (fix id, GranWall) of every wall/gran defined, in order
 
     def wall_type(self, fix: str, mesh: int = 0) -> int | None:
         """The LIGGGHTS atom type of a wall fix's primitive, or of its mesh number ``mesh``."""
@@ -674,22 +709,32 @@ class ScriptInfo:
             self.randoms.append(key)
 
     def learn(self, cmd: Command) -> None:
+        """What a command run declares: the one reading of a script's commands, for runs (as
+        each runs) and post (over the whole script). ScriptError for a wall the host cannot read."""
         w = cmd.words
+        if w[0] == "timestep" and len(w) > 1:
+            self.timestep = w[1]
+        elif w[0] == "compute" and len(w) > 3:
+            self.computes[w[1]] = cmd
         if w[0] == "fix" and len(w) >= 4:
             style = w[3]
             self.fixes[w[1]] = cmd
             if style == "wall/gran":
                 self.walls[w[1]] = parse_wall(cmd)
+                self.walls_defined.append((w[1], self.walls[w[1]]))
             elif style.startswith("mesh/surface") and "type" in w:
                 self.mesh_types[w[1]] = int(w[w.index("type") + 1])
                 if _keyword(w, "temperature") is not None:
                     self.mesh_temperatures[w[1]] = _keyword(w, "temperature")
             elif style == "heat/gran":
                 self.heat_gran = w[1]
+                self.conductions.append(w[1])
             elif style == "property/atom" and len(w) >= 5 and w[4] == "Temp":
                 self.temp_fix = True
             elif style == "property/global" and len(w) >= 5:
                 self.globals[w[4]] = w[1]
+                if len(w) > 5:
+                    self.global_values[w[4]] = cmd
             elif style.startswith("move/mesh") and w[1] not in self.mesh_motions:
                 self.mesh_motions.append(w[1])
             elif style == "insert/stream" and w[1] not in self.streams:

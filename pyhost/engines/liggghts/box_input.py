@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from plugins.dem.hertz import effective_modulus, hertz_collision_time
+from pyhost.collisions import sphere_mass
 from pyhost.schema import Scene, SceneError
 from pyhost.walls import face_primitive
 
@@ -35,7 +36,7 @@ class Particles:
 
     @property
     def mass(self):
-        return 4.0 / 3.0 * np.pi * self.radius**3 * self.density
+        return sphere_mass(self.radius, self.density)
 
 
 NUM = "%.17g"
@@ -164,7 +165,7 @@ def dem_collision_time(scene: Scene, v: float) -> float:
     for grp in scene.particles:
         m = scene.materials[grp.material]
         E = effective_modulus(m.dem.youngs_modulus, m.dem.poisson_ratio, m.dem.youngs_modulus, m.dem.poisson_ratio)
-        mass = 4.0 / 3.0 * math.pi * grp.radius**3 * m.density
+        mass = sphere_mass(grp.radius, m.density)
         times.append(hertz_collision_time(E, grp.radius / 2.0, mass / 2.0, v))
     return min(times)
 
@@ -185,7 +186,7 @@ def script_dem_contacts(scene, dem) -> list:
     import dataclasses
 
     from pyhost.schema import DemContact
-    from pyhost.script import ScriptError
+    from pyhost.engines.liggghts.script import ScriptError
 
     wall_of = {}
     for w in scene.walls:

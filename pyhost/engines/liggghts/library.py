@@ -42,7 +42,7 @@ from pyhost.walls import primitive_overlap
 LIB = "libliggghts.so.3"
 _ISOLATED = "OMPI_MCA_ess_singleton_isolated"
 _disarm_registered = False
-HELPER = Path(__file__).resolve().parents[2] / ".setup" / "lib" / "libcollheat_liggghts.so"
+HELPER = Path(__file__).resolve().parents[3] / ".setup" / "lib" / "libcollheat_liggghts.so"
 
 _c = ctypes
 _vp, _cp, _int = _c.c_void_p, _c.c_char_p, _c.c_int
@@ -526,12 +526,6 @@ class Liggghts:
         lo = np.array([get(f"box{a}lo") for a in "xyz"])
         hi = np.array([get(f"box{a}hi") for a in "xyz"])
         return lo, hi
-
-    def radii_of(self, ids) -> np.ndarray:
-        """Radii [m] of the atoms with these ids (any shape)."""
-        lookup = np.zeros(int(self.atom("id").max(initial=0)) + 1)
-        lookup[self.atom("id")] = self.atom("radius")
-        return lookup[np.asarray(ids)]
 
     def atom(self, name: str) -> np.ndarray:
         """Zero-copy view of a per-atom array of the local atoms, in LIGGGHTS' local order:
