@@ -3,7 +3,7 @@
 ``simulate`` is the one entry: it builds the DEM (the user's LIGGGHTS script, or the box
 world a box scene describes: particles placed, walls, the LIGGGHTS input written), starts the
 fluid solver only when the scene has a fluid (a box case, or the user's OpenFOAM case copied
-and meshed), and hands both to ``pyhost.loop.run_scene``. The ``run`` command, the tests and
+and meshed), and hands both to ``pyhost.run_scene.run_scene``. The ``run`` command, the tests and
 the benchmarks call it; it prints nothing of its own but warnings.
 """
 from __future__ import annotations
@@ -145,7 +145,7 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
     then are not collisions of this run. ``restart``: LIGGGHTS' restart file of a checkpoint
     to read instead of the particles (the same commands re-issued, with the same ids)."""
     from pyhost.dem_input import input_lines, place_particles, write_data
-    from pyhost.loop import HostWall, Known
+    from pyhost.tables import HostWall, Known
 
     folder = out / "dem"
     folder.mkdir(parents=True, exist_ok=True)
@@ -175,7 +175,7 @@ def user_script(scene):
     atom type of a material that gives a temperature per type (``NAME (type T)``: hot and
     cold beads of one material apart); walls = the scene's [[walls]] (by fix id) and every
     other wall/gran fix of the script as an adiabatic wall."""
-    from pyhost.loop import HostWall, Known
+    from pyhost.tables import HostWall, Known
     from pyhost.scene import SceneError
 
     materials = list(scene.materials)
@@ -275,7 +275,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     from pyhost.checkpoint import fingerprints
     from pyhost.engines.dem import Dem
     from pyhost.dem_input import dem_collision_time
-    from pyhost.loop import run_scene
+    from pyhost.run_scene import run_scene
     from pyhost.script import check_types, read_script
 
     effects = scene.effects_summary()
