@@ -53,7 +53,7 @@ class Coupling:
         self.every = {}
         self.ready = resume is not None      # a consistent state to checkpoint (after start())
         self.ctx = Context(scene, dem, self.out, fluid, driven, materials, TypeMaterials(type_material, scene.path),
-                           known, resume["logs"] if resume else {}, clock_of=self)
+                           known, resume["logs"] if resume else {}, _clock=self)
         self.effect_list = self.ctx.build()   # the effects the scene asks for, in the order they act
         self.at_run(walls)
         for effect in self.effect_list:

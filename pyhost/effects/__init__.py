@@ -91,7 +91,14 @@ class Context:
     (pyhost.particles.TypeMaterials); ``known``: what the host knows of each particle
     (pyhost.particles.Known); ``logs``: a checkpoint's output marks (empty: a new run);
     ``totals`` (summary.json's), ``warned`` (warnings said once). The loop's clock is read
-    through ``t``, ``steps``, ``clock``, ``time_of``, ``every`` and ``ready``."""
+    through ``t``, ``steps``, ``clock``, ``time_of``, ``every`` and ``ready``; the effects
+    built before one, ``present``; another effect, ``find``; the balance's ``track_particles``
+    and ``C``. ``READS`` is all of it: an effect reads nothing else of the run
+    (tests/unit/test_structure.py)."""
+
+    READS = ("scene", "dem", "out", "fluid", "driven", "effects", "heat", "materials", "capacity", "type_material",
+             "materials_of", "known", "logs", "totals", "warned", "t", "steps", "clock", "time_of", "every", "ready",
+             "present", "find", "track_particles", "C")
 
     scene: object
     dem: object
@@ -102,7 +109,7 @@ class Context:
     types: object
     known: object
     logs: dict
-    clock_of: object = None             # the loop (its clock; set by the loop)
+    _clock: object = None               # the loop, whose clock the properties below read
     totals: dict = field(default_factory=totals)
     warned: set = field(default_factory=set)
     present: list = field(default_factory=list)     # the effects built, in the registry's order
@@ -133,15 +140,15 @@ class Context:
         return self.types.of(types)
 
     # -- the loop's clock, read-only --
-    t = property(lambda self: self.clock_of.t, doc="the simulated time [s]")
-    steps = property(lambda self: self.clock_of.steps, doc="the coupled DEM steps so far")
-    clock = property(lambda self: self.clock_of.clock, doc="(t [s], step, dt [s]): LIGGGHTS' step s is at t + (s - step) dt")
-    every = property(lambda self: self.clock_of.every, doc="DEM steps between each interval's ends, by name")
-    ready = property(lambda self: self.clock_of.ready, doc="whether the run has a state whole enough to checkpoint")
+    t = property(lambda self: self._clock.t, doc="the simulated time [s]")
+    steps = property(lambda self: self._clock.steps, doc="the coupled DEM steps so far")
+    clock = property(lambda self: self._clock.clock, doc="(t [s], step, dt [s]): LIGGGHTS' step s is at t + (s - step) dt")
+    every = property(lambda self: self._clock.every, doc="DEM steps between each interval's ends, by name")
+    ready = property(lambda self: self._clock.ready, doc="whether the run has a state whole enough to checkpoint")
 
     def time_of(self, step) -> float:
         """The simulated time [s] of LIGGGHTS' step number ``step`` of the run under way."""
-        return self.clock_of.time_of(step)
+        return self._clock.time_of(step)
 
     # -- the energy balance's service (pyhost.effects.balance), where particles have temperatures --
     def track_particles(self, atoms, departures: bool = True) -> None:

@@ -235,3 +235,30 @@ def test_the_loop_only_schedules():
     named = sorted(n for n in names | modules if re.search(rf"\b{re.escape(n)}\b", text))
     named += sorted(f'find("{name}")' for name, _, _ in REGISTRY if f'find("{name}")' in text)
     assert named == []
+
+
+def context_reads(path) -> set:
+    """The attributes an effect module reads of its context: ``self.loop.X`` and ``loop.X``."""
+    found = set()
+    for node in ast.walk(ast.parse(Path(path).read_text())):
+        if isinstance(node, ast.Attribute):
+            v = node.value
+            if (isinstance(v, ast.Name) and v.id == "loop" or isinstance(v, ast.Attribute) and v.attr == "loop"
+                    and isinstance(v.value, ast.Name) and v.value.id == "self"):
+                found.add(node.attr)
+    return found
+
+
+def test_the_effects_read_only_their_declared_context():
+    """Issue 45: an effect reads of the run only what ``pyhost.effects.Context.READS`` declares
+    (no attribute of the loop, no other effect but through ``find``), and the context has each."""
+    from pyhost.effects import Context
+
+    assert context_reads(ROOT / "pyhost" / "effects" / "balance.py") >= {"dem", "totals"}   # the scan sees them
+    used = {f.name: sorted(context_reads(f) - set(Context.READS))
+            for f in sorted((ROOT / "pyhost" / "effects").glob("*.py")) if f.name != "__init__.py"}
+    assert {k: v for k, v in used.items() if v} == {}
+    fields = set(Context.__dataclass_fields__)
+    set_later = {"effects", "heat", "capacity", "type_material"}        # (__post_init__'s)
+    assert [r for r in Context.READS if r not in fields | set_later and not hasattr(Context, r)] == []
+    assert not any(r.startswith("_") for r in Context.READS)
