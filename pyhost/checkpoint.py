@@ -140,11 +140,10 @@ def _write_into(coupling, new: Path) -> None:
         # them at its next re-neighbouring, which the set-up after write_restart is; a set-up
         # first drops them from the restart file too (they used to stay in it and not in
         # host.npz: "corrupt checkpoint", exit 2, at the checkpoint after a box emptied)
-        dem.engine_command("run 0 post no")
+        dem.drop_outside()
         kept = np.isin(ids, dem.per_atom(("id",))[0])
         ids, f, torque, release = ids[kept], f[kept], torque[kept], [r[kept] for r in release]
-    dem.engine_command(f"write_restart {new / RESTART}")
-    dem.check_restart(new / RESTART)
+    dem.write_restart(new / RESTART)
     dem.run(0)                                   # set up again, then the step's own forces back
     _put_forces(dem, ids, f, torque)
     values, arrays = state(coupling)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from pyhost import checkpoint, signals
 from pyhost.dem_input import script_dem_contacts
+from pyhost.engines.cfdem_commands import couples_to_cfd
 from pyhost.engines.dem import Dem
 from pyhost.engines.liggghts import LiggghtsError
 from pyhost.loop import Coupling
@@ -62,7 +63,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, f
         raise ScriptError(f"--extend: {scene.path}'s script jumps back after its last run command, so the host "
                           "cannot tell which run is the last to extend")
     # CFDEM runs a script whole (its last run too: often 'run 1'), then its coupling drives the DEM
-    cfdem = any(c.name == "fix" and c.words[3:4] == ["couple/cfd"] for c in commands)
+    cfdem = couples_to_cfd(commands)
     prepared = None
     held = []                           # the reset_timestep commands right before the first run
 

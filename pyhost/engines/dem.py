@@ -501,6 +501,16 @@ class Dem:
         """A LIGGGHTS command of the host's own (not the script's: not learnt), on every rank."""
         self._raw(line)
 
+    def write_restart(self, path: Path) -> None:
+        """LIGGGHTS' restart file of the state now at ``path``, read back whole (``check_restart``)."""
+        self._raw(f"write_restart {path}")
+        self.check_restart(path)
+
+    def drop_outside(self) -> None:
+        """A set-up without steps, at which LIGGGHTS drops the particles past a fixed face of the
+        box ('thermo_modify lost ignore'), as at any re-neighbouring."""
+        self._raw("run 0 post no")
+
     def add_velocity(self, local_index, dv) -> None:
         """Add dv [m/s] to the velocity of these atoms (indices into the last ``atoms()``)."""
         v = self.lmp.atom("v") if self.link is None else self._pending[0].v

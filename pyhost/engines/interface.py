@@ -46,6 +46,12 @@ class DemEngine(Protocol):
     def engine_command(self, line: str) -> None:
         """Run a command of the host's own (write_restart, ...)."""
 
+    def write_restart(self, path) -> None:
+        """The engine's restart file of the state now at ``path``, checked whole (``check_restart``)."""
+
+    def drop_outside(self) -> None:
+        """A set-up without steps that drops the particles past a fixed face of the box."""
+
     def check_restart(self, path) -> None:
         """The engine's restart file just written at ``path`` is whole (read back): OSError
         naming it if not (a full disk the engine did not report)."""

@@ -272,11 +272,11 @@ def test_a_stop_during_a_checkpoint_leaves_no_half_checkpoint(tmp_path):
     (tmp_path / "checkpoint").mkdir()
     (tmp_path / "checkpoint" / "manifest.json").write_text("{}")
 
-    def stopped(line):
+    def stopped(path):
         (tmp_path / ".checkpoint.new" / "dem.restart").write_bytes(b"half")
         raise Interrupted(signal.SIGTERM)
     dem = SimpleNamespace(per_atom=lambda names: (np.arange(2.0), np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3))),
-                          engine_command=stopped, info=SimpleNamespace(streams=[]),
+                          write_restart=stopped, info=SimpleNamespace(streams=[]),
                           box=lambda: (-np.ones(3), np.ones(3), np.zeros(3, bool)))
     with pytest.raises(Interrupted):
         checkpoint.write(SimpleNamespace(out=tmp_path, dem=dem, scene=None))
