@@ -34,6 +34,11 @@ WALL_CLOCK = re.compile(
 fingerprint in a checkpoint's manifest (a restart refuses a checkpoint of other sources)."""
 
 
+RUN = Path("/tmp/same_outputs_loop.run")
+"""Where every run writes, whichever tree and whichever DIR (paths in the outputs are the same):
+moved to DIR/CASE after."""
+
+
 def take(folder: Path, cases: list[str]) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     for case in cases:
