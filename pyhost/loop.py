@@ -146,7 +146,9 @@ class Coupling:
             self.progress.of_run(self.t, self.totals)
             signals.check()
         for effect in self.effect_list:      # (a fluid's last advance, if it ran beside the DEM: a failure
-            effect.end_run()                 # in it stops this run like any other, summary and exit 3)
+            effect.join()                    # in it stops this run like any other, summary and exit 3)
+        for effect in self.effect_list:
+            effect.end_run()
 
     def write_frame(self) -> None:
         self.frame_step = self.steps

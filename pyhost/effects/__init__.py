@@ -25,7 +25,9 @@ Hooks, called by the loop on every effect in the registry's order (the defaults 
     couple()       every coupling interval (an effect's ``every["couple"]`` DEM steps)
     row(atoms)     its history values at a frame, in the order of ``columns``
     frame()        its files at a frame
-    end_run()      at the end of each run's steps
+    join()         at the end of each run's steps: what it runs beside the DEM finished (a
+                   failure there stops the run before any effect's end_run)
+    end_run()      at the end of each run's steps, after every effect's join
     settle()       work owed since the last chunk (contact events not yet harvested): before
                    a checkpoint and at the end
     state()        (JSON values, arrays) for a checkpoint; restore(state) takes them back
@@ -204,6 +206,9 @@ class Effect:
         return ()
 
     def frame(self) -> None:
+        pass
+
+    def join(self) -> None:
         pass
 
     def end_run(self) -> None:

@@ -202,7 +202,7 @@ class FluidExchange(Effect):
             p, u = self.fluid.fields()
             self.frames.write(self.loop.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)
 
-    def end_run(self) -> None:
+    def join(self) -> None:
         """The last advance, if it ran beside the DEM: a failure in it stops this run like any
         other (summary, exit 3)."""
         self.fluid.wait()
