@@ -147,7 +147,7 @@ def _write_into(coupling, new: Path) -> None:
     dem.check_restart(new / RESTART)
     dem.run(0)                                   # set up again, then the step's own forces back
     _put_forces(dem, ids, f, torque)
-    values, arrays = coupling.state()
+    values, arrays = state(coupling)
     with naming(new / "host.npz"):
         np.savez(new / "host.npz", ids=ids, f=f, torque=torque, **dict(zip(streams, release)), **arrays)
     write_atomic(new / "host.json", json.dumps(values, indent=1))
@@ -181,6 +181,50 @@ def _put_forces(dem, ids, f, torque, **more) -> None:
     except ValueError as exc:
         raise UserError(f"checkpoint: the restart file's atoms are not those of host.npz (corrupt checkpoint): "
                         f"{exc}") from None
+
+
+def state(coupling) -> tuple[dict, dict]:
+    """The host's state at the end of a step: (JSON values, arrays), the loop's (its clock,
+    totals, the script's input loop, the DEM's mesh motion, random states and insertions) and
+    each effect's, their files flushed first (every frame a log names is on disk)."""
+    for effect in coupling.effect_list:
+        effect.flush()
+    dem, ctx = coupling.dem, coupling.ctx
+    values = dict(clock=coupling.clock, t_step=coupling.t_step, t_begin=coupling.t_begin, steps=coupling.steps,
+                  t=coupling.t, totals=ctx.totals, warned=sorted(ctx.warned), run_left=coupling.run_left,
+                  program=coupling.program.state() if coupling.program else {},
+                  mesh_motion=dem.mesh_motion_times(), randoms=dem.random_states(),
+                  insertions=dem.insertion_progress())
+    arrays, logs = {}, {}
+    for effect in coupling.effect_list:
+        v, a = effect.state()
+        logs.update(v.pop("logs", {}))
+        values.update(v)
+        arrays.update(a)
+    values["frame_step"] = coupling.frame_step
+    values["logs"] = logs
+    return values, arrays
+
+
+def restore(coupling, state: dict) -> None:
+    """``coupling`` (just built) continued from ``state`` (values and arrays of :func:`state` in
+    one dict, ``load``'s): the loop's clock and totals, the DEM's forces, mesh motion, random
+    states and insertions, each effect's state."""
+    from pyhost.effects import totals
+
+    coupling.steps, coupling.t = state["steps"], state["t"]
+    coupling.clock = tuple(state["clock"])
+    coupling.t_step, coupling.t_begin = state["t_step"], state["t_begin"]
+    coupling.ctx.totals = dict(totals(), **state["totals"])    # (a total newer than the checkpoint starts at 0)
+    coupling.ctx.warned = set(state["warned"])
+    coupling.frame_step = state.get("frame_step")
+    dem = coupling.dem
+    restore_forces(dem, state)
+    dem.set_mesh_motion_times(state.get("mesh_motion", {}))
+    dem.set_random_states(state.get("randoms", {}))
+    dem.set_insertion_progress(state.get("insertions", {}))
+    for effect in coupling.effect_list:
+        effect.restore(state)
 
 
 def restore_forces(dem, state: dict) -> None:

@@ -493,3 +493,7 @@ class Progress:
         left = (self.end - t) / rate if rate > 0 else float("inf")
         print(f"t = {t:.5g} / {self.end:.5g} s ({100 * t / self.end:5.1f} %), "
               f"{rate:.3g} s simulated per s, {left:.0f} s left{extra}", file=self.stream, flush=True)
+
+    def of_run(self, t: float, totals: dict, force: bool = False) -> None:
+        """A coupled run's progress at ``t`` [s]: with its collisions so far (summary.json's totals)."""
+        self.update(t, f", {totals['collisions']} collisions", force)

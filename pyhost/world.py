@@ -3,7 +3,7 @@
 ``simulate`` is the one entry: it builds the DEM (the user's LIGGGHTS script, or the box
 world a box scene describes: particles placed, walls, the LIGGGHTS input written), starts the
 fluid solver only when the scene has a fluid (a box case, or the user's OpenFOAM case copied
-and meshed), and hands both to ``pyhost.loop.run_scene``. The ``run`` command, the tests and
+and meshed), and hands both to ``pyhost.run_scene.run_scene``. The ``run`` command, the tests and
 the benchmarks call it; it prints nothing of its own but warnings.
 """
 from __future__ import annotations
@@ -161,7 +161,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     from pyhost.engines.dem import Dem
     from pyhost.engines.liggghts.box_input import dem_collision_time
     from pyhost.engines.liggghts.worlds import box_world, user_script
-    from pyhost.loop import run_scene
+    from pyhost.run_scene import run_scene
     from pyhost.engines.liggghts.script import check_types, read_script
 
     effects = scene.effects_summary()

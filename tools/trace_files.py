@@ -35,7 +35,7 @@ class Done(Exception):
 
 
 STAGES = (("scene", "pyhost/scene.py", "load_scene"), ("world", "pyhost/world.py", "simulate"),
-          ("script", "pyhost/loop.py", "run_scene"), ("effects", "pyhost/loop.py", "__init__"),
+          ("script", "pyhost/run_scene.py", "run_scene"), ("effects", "pyhost/loop.py", "__init__"),
           ("effects", "pyhost/loop.py", "start"))
 """The set-up's stages, each from a call of its function (innermost wins); the command's own
 calls (output folder, pictures) are 'command'."""

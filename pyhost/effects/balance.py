@@ -38,9 +38,16 @@ class EnergyBalance(Effect):
         self.CT0 = 0.0
         self.residual = self.came_in = None
 
-    def begin(self, atoms) -> None:
-        """The particles at the start: their heat content is the balance's start, not energy in."""
-        self.track(atoms)
+    def at_run(self, walls) -> None:
+        """At each of a script's runs: its fix heat/gran checked against the scene."""
+        self.check_heat_gran()
+
+    def begin(self, resumed: bool) -> None:
+        """The particles at the start: their heat content is the balance's start, not energy in
+        (a restart: the checkpoint's start)."""
+        if resumed:
+            return
+        self.track(self.loop.dem.atoms(True))
         t = self.loop.totals
         self.CT0 = t.pop("energy_in")
         t["energy_in"] = 0.0
@@ -106,6 +113,13 @@ class EnergyBalance(Effect):
         self.CT_by_id[ids] = C * atoms.T
         self.M_by_id[ids] = atoms.mass
         self.C = C
+
+    def before_run(self, resumed: bool) -> None:
+        if not resumed:         # (a restart continues a run: no script command came in between)
+            self.resync()
+
+    def end_run(self) -> None:
+        self.track(self.loop.dem.atoms(True))
 
     def resync(self) -> None:
         """Before each run: heat content that the script's own commands changed since the last
@@ -205,7 +219,7 @@ class EnergyBalance(Effect):
         self.residual = (CT - self.CT0 - t["heat_from_walls"] - t["energy_in"] + t["energy_out"]
                          - t["energy_set_by_script"] - t["energy_mass_change"] - t["heat_convected"]
                          - t["heat_from_sources"] - t["heat_from_script_walls"]
-                         + t.get("heat_gran_walls_undone", 0.0))   # J (heat/gran's walls during collisions: taken back)
+                         + t["heat_gran_walls_undone"])   # J (heat/gran's walls during collisions: taken back)
         error = self.residual / max(self.came_in, 1e-300)       # relative to all that came in
         summary.update(sum_mcT_start=self.CT0, sum_mcT_end=CT, energy_balance_error=error)
         if status == "completed" and not abs(error) <= TOLERANCE:

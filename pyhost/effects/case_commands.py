@@ -19,20 +19,6 @@ from pyhost.engines.fluid_case import start_time
 from pyhost.engines.liggghts.script import Command
 
 
-def case_commands(loop, driven: float | None):
-    """The effect for the loop's scene, a user's fluid case, or None: no command besides the
-    coupled run in its liggghtsCommands (or none: not a CFDEM case)."""
-    case = loop.scene.folder / loop.scene.fluid.case
-    commands = read_commands(case, loop.every["couple"])
-    if not commands:
-        return None
-    control = FoamFile(case / "system" / "controlDict").as_dict()
-    start = start_time(case)[0]
-    if driven is None:
-        driven = float(control["endTime"]) - start
-    return CaseCommands(loop, commands, control, start, driven)
-
-
 class CaseCommands(Effect):
     """``commands``: the case's (``read_commands``); ``control``: the fluid case's controlDict
     (its write times); ``start`` [s]: the time the fluid starts from; ``driven`` [s]: the
@@ -40,13 +26,28 @@ class CaseCommands(Effect):
 
     TOTALS = dict(case_commands_run=0)
 
+    @classmethod
+    def build(cls, loop):
+        """The effect for the loop's scene, a user's fluid case, or None: no command besides the
+        coupled run in its liggghtsCommands (or none: not a CFDEM case, no fluid case)."""
+        if loop.fluid is None or not loop.scene.fluid.case:
+            return None
+        case = loop.scene.folder / loop.scene.fluid.case
+        commands = read_commands(case, loop.scene.time.couple_every)
+        if not commands:
+            return None
+        control = FoamFile(case / "system" / "controlDict").as_dict()
+        start = start_time(case)[0]
+        driven = loop.driven if loop.driven is not None else float(control["endTime"]) - start
+        return cls(loop, commands, control, start, driven)
+
     def __init__(self, loop, commands, control: dict, start: float, driven: float):
         super().__init__(loop)
         self.commands = commands
         self.control = control
         self.start_time = start
-        self.interval = loop.every["couple"] * loop.dem.dt
-        self.last = math.floor((driven + SMALL) / loop.dem.dt / loop.every["couple"])    # CFDEM's lastCouplingStep
+        self.interval = loop.scene.time.couple_every * loop.dem.dt
+        self.last = math.floor((driven + SMALL) / loop.dem.dt / loop.scene.time.couple_every)    # CFDEM's lastCouplingStep
         self.said = set()              # commands said at their first run
 
     def couple(self) -> None:
@@ -75,7 +76,7 @@ class CaseCommands(Effect):
     def temperatures(self):
         """(ids, T, m c) of the particles now, copied; None without particle temperatures."""
         loop = self.loop
-        if loop.balance is None:
+        if loop.find("balance") is None:
             return None
         atoms = loop.dem.atoms(True)
         return atoms.id.copy(), atoms.T.copy(), atoms.mass * loop.capacity[loop.materials_of(atoms.type)]

@@ -41,12 +41,18 @@ ON_RANKS = True
 False: rank 0 moves all in time order (``harvest_partly`` between frames, else on the atoms
 the frame gathers), the reference tests/cases/test_mpi.py compares it with."""
 
+HARVEST_EVERY = 1000
+"""DEM steps between harvests of the contact events at most (they are also taken at every
+frame and checkpoint, and at a fluid exchange that reads temperatures): bounds the
+recorder's buffer and the wait of a signal (a stop is taken between two DEM chunks)."""
+
 COLLISION_COLUMNS = ("time", "step", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 
 
 class CollisionHeat(Effect):
-    """``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes;
-    ``logs``: the checkpoint's output marks to continue from (None: a new run)."""
+    """``walls``: the HostWall of every LIGGGHTS wall, in the order of their contact codes
+    (``at_run``); the checkpoint's output marks to continue from: ``loop.logs``. Its interval:
+    ``harvest``, every time.sample_every steps with restitution feedback, else HARVEST_EVERY."""
 
     TOTALS = dict(collisions=0, particle_particle=0, particle_wall=0, heat_moved=0.0, heat_from_walls=0.0,
                   capped=0, clipped=0, heat_gran_undone=0.0, heat_gran_walls_undone=0.0,
@@ -54,7 +60,7 @@ class CollisionHeat(Effect):
                   collisions_moved_on_ranks=0, contacts_changed_rank=0, restitution_late=0,
                   restitution_not_imposed=0, heat_gran_undo_cut=0, heat_by_model=None)
 
-    def __init__(self, loop, walls, logs: dict | None = None):
+    def __init__(self, loop):
         super().__init__(loop)
         scene = loop.scene
         self.t_coll_of = {}                      # (key, begin step) -> t_coll [s] of pair collisions under heat/gran
@@ -62,10 +68,10 @@ class CollisionHeat(Effect):
         self.targets = {}                        # key -> (separation speed, normal) the recorder imposes at the end
         self.last_batch = ON_RANKS_FROM          # collisions of the last harvest (MPI: where the next moves)
         columns = COLLISION_COLUMNS + tuple(f"Q_{m}" for m in scene.effects.heat_models[1:])
-        mark = (logs or {}).get("collisions")
+        mark = loop.logs.get("collisions")
         self.log = (ColumnLog(loop.out / "collisions", collision_kinds(columns), mark)
                     if scene.output.collisions == "binary" else CsvLog(loop.out / "collisions.csv", columns, mark))
-        self.update_walls(walls)
+        self.every = dict(harvest=scene.time.sample_every if self.restitution else HARVEST_EVERY)
 
     @property
     def dem(self):
@@ -83,7 +89,18 @@ class CollisionHeat(Effect):
     def warned(self) -> set:
         return self.loop.warned
 
-    def update_walls(self, walls) -> None:
+    @classmethod
+    def end_totals(cls, totals: dict, scene) -> None:
+        """A scene without collisions: each model's 0 J."""
+        if totals["heat_by_model"] is None:
+            totals["heat_by_model"] = dict.fromkeys(scene.effects.heat_models, 0.0)
+
+    def begin(self, resumed: bool) -> None:
+        """The walls' contacts now are open ones: one that begins at the next step is a collision
+        (prepare's set-up left the lists)."""
+        self.dem.events.sync()
+
+    def at_run(self, walls) -> None:
         """The LIGGGHTS walls as the host sees them (a script may add walls between runs)."""
         self.walls = walls
         self.wall_index = {(w.fix, w.mesh): k for k, w in enumerate(walls)}
@@ -121,13 +138,14 @@ class CollisionHeat(Effect):
         every collision begun, to leave each its t_coll). A fluid exchange without either
         changes no temperature and reads none: the events wait for the next of the others, in
         larger batches (the heat moved is the same, collision after collision in their order)."""
-        convects = self.loop.fluid_exchange is not None and self.loop.fluid_exchange.convection
+        fluid = self.loop.find("fluid")
+        convects = fluid is not None and fluid.convection
         return any(due[k] for k in ("harvest", "frame", "checkpoint", "conduct")) or (
             due["couple"] and (convects or bool(self.dem.events.window)))
 
-    def end_of_run(self, atoms) -> None:
+    def end_run(self) -> None:
         """At the end of each of the script's runs: the events so far."""
-        self.harvest(atoms)
+        self.harvest(self.dem.atoms(self.loop.heat))
 
     def state(self) -> tuple[dict, dict]:
         return (dict(logs=dict(collisions=self.log.mark()), last_batch=self.last_batch),
@@ -192,7 +210,7 @@ class CollisionHeat(Effect):
         those left over on the atoms of their events only (``harvest``), counts all, writes all
         rows in the serial order and, with restitution feedback, gives every collision its
         separation speed (gathering the atoms of the contacts that ended before it could)."""
-        loop, balance = self.loop, self.loop.balance
+        loop, balance = self.loop, self.loop.find("balance")
         models = self.scene.effects.heat_models
         setup = RankHeat(loop.materials, loop.type_material, loop.capacity, tuple(models),
                          self.scene.effects.heat_path, self.T_wall, self.wall_material, loop.clock,
@@ -282,8 +300,9 @@ class CollisionHeat(Effect):
         order = np.lexsort((j, cols["i"], wall_of(j)[0], step))
         cols = {k: v[order] for k, v in cols.items()}
         self.record(cols)
-        if self.loop.conduction is not None:
-            self.loop.conduction.collided(cols)
+        conduction = self.loop.find("conduction")
+        if conduction is not None:
+            conduction.collided(cols)
         if self.restitution:
             self.ask_restitution(atoms, np.concatenate([b[3] for b in batches])[order], cols["e"], ends)
 
@@ -470,7 +489,7 @@ class CollisionHeat(Effect):
             self.dem.add_velocity(jl[pair], dv_j[pair])
         return clipped
 
-    def flush_events(self) -> None:
+    def settle(self) -> None:
         """The contact events recorded since the last harvest, taken now (a run stopped
         between harvests: its checkpoint and summary hold every collision)."""
         if self.loop.ready and (self.dem.events.waiting or self.dem.events.window):

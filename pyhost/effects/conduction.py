@@ -64,6 +64,15 @@ class LastingConduction(Effect):
                                 if a and b else np.nan for b in softened] for a in softened])
         self.t_last = loop.t
         self.owned = {}
+        self.every = dict(conduct=c.every)
+
+    def after_chunk(self, due: dict) -> None:
+        if due["conduct"]:
+            self.conduct()
+
+    def end_run(self) -> None:
+        """The run's steps since the last update."""
+        self.conduct()
 
     def collided(self, cols: dict) -> None:
         """Collisions just logged (``CollisionHeat.conclude``): their pair contacts belong to

@@ -60,17 +60,22 @@ def layer_pressure_drop(fluid, up) -> float:
 
 
 class FluidExchange(Effect):
-    """``fluid``: the running solver (pyhost.engines.openfoam.FluidSolver); ``logs``: the
-    checkpoint's output marks to continue from (None: a new run)."""
+    """``fluid``: the running solver (pyhost.engines.openfoam.FluidSolver, the context's
+    ``fluid``); its interval: ``couple``, every time.couple_every DEM steps."""
 
     TOTALS = dict(heat_convected=0.0, heat_convected_gross=0.0)
 
-    def __init__(self, loop, fluid, logs: dict | None = None):
+    @classmethod
+    def build(cls, ctx):
+        return cls(ctx, ctx.fluid) if ctx.fluid is not None else None
+
+    def __init__(self, loop, fluid):
         super().__init__(loop)
         self.fluid = fluid
+        self.every = dict(couple=loop.scene.time.couple_every)
         self.convection = loop.effects["convection"]
         self.columns = FLUID_COLUMNS + (GAS_COLUMNS if self.convection else ())
-        self.frames = (VtkSeries(loop.out / "vtk", "fluid", (logs or {}).get("fluid"))
+        self.frames = (VtkSeries(loop.out / "vtk", "fluid", loop.logs.get("fluid"))
                        if loop.scene.output.vtk else None)
         self.force = (np.zeros(0, np.int64), np.zeros((0, 3)))   # ids and force [N] of the last coupling
         self.gas_energy0 = 0.0
@@ -197,6 +202,11 @@ class FluidExchange(Effect):
             p, u = self.fluid.fields()
             self.frames.write(self.loop.t, self.fluid.cell_centres, alpha=self.fluid.alpha, velocity=u, pressure=p)
 
+    def join(self) -> None:
+        """The last advance, if it ran beside the DEM: a failure in it stops this run like any
+        other (summary, exit 3)."""
+        self.fluid.wait()
+
     def flush(self) -> None:
         self.fluid.wait()
         if self.frames is not None:
@@ -216,7 +226,7 @@ class FluidExchange(Effect):
     def finish(self, summary: dict, status: str) -> None:
         """With convection, the energy balance of particles and gas together (the gas gains
         through its boundaries); the particles' own is the balance effect's."""
-        balance = self.loop.balance
+        balance = self.loop.find("balance")
         if not (self.convection and status == "completed" and balance is not None and balance.residual is not None):
             return
         t = self.loop.totals

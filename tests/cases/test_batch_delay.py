@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from pyhost import loop
+from pyhost.effects import collisions as collision_effect
 from pyhost.scene import load_scene
 from pyhost.world import simulate
 
@@ -17,7 +17,7 @@ CASES = Path(__file__).resolve().parents[2] / "cases"
 
 
 def run(case: str, out, harvest_every: int, monkeypatch, **time):
-    monkeypatch.setattr(loop, "HARVEST_EVERY", harvest_every)
+    monkeypatch.setattr(collision_effect, "HARVEST_EVERY", harvest_every)
     scene = load_scene(CASES / case / "case.toml")
     scene = dataclasses.replace(scene, time=dataclasses.replace(scene.time, **time),
                                 output=dataclasses.replace(scene.output, vtk=False, pictures=False))

@@ -272,7 +272,7 @@ def test_a_stop_during_a_checkpoint_leaves_no_half_checkpoint(tmp_path):
     (tmp_path / "checkpoint").mkdir()
     (tmp_path / "checkpoint" / "manifest.json").write_text("{}")
 
-    def stopped(line):
+    def stopped(path):
         (tmp_path / ".checkpoint.new" / "dem.restart").write_bytes(b"half")
         raise Interrupted(signal.SIGTERM)
     dem = SimpleNamespace(per_atom=lambda names: (np.arange(2.0), np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3))),

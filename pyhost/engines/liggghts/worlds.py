@@ -20,7 +20,7 @@ def box_world(scene, out: Path, start=None, restart: Path | None = None):
     e.g. a settled bed) to start from instead of the scene's placement; the contacts present
     then are not collisions of this run. ``restart``: LIGGGHTS' restart file of a checkpoint
     to read instead of the particles (the same commands re-issued, with the same ids)."""
-    from pyhost.loop import HostWall, Known
+    from pyhost.tables import HostWall, Known
 
     folder = out / "dem"
     folder.mkdir(parents=True, exist_ok=True)
@@ -50,7 +50,7 @@ def user_script(scene):
     atom type of a material that gives a temperature per type (``NAME (type T)``: hot and
     cold beads of one material apart); walls = the scene's [[walls]] (by fix id) and every
     other wall/gran fix of the script as an adiabatic wall."""
-    from pyhost.loop import HostWall, Known
+    from pyhost.tables import HostWall, Known
     from pyhost.scene import SceneError
 
     materials = list(scene.materials)
