@@ -85,9 +85,18 @@ done_build() { mv "$out/.$1.stamp.new" "$out/.$1.stamp"; }
 helper=$out/lib/libcollheat_liggghts.so
 if changed liggghts plugins/liggghts "$helper"; then
     echo "setup_engines: compiling plugins/liggghts"
-    g++ -O2 -fPIC -shared -DOMPI_SKIP_MPICXX -I/usr/include/liggghts \
-        $(pkg-config --cflags ompi 2>/dev/null || echo -I/usr/lib/x86_64-linux-gnu/openmpi/include) \
-        plugins/liggghts/collheat_liggghts.cpp plugins/liggghts/contact_events.cpp plugins/liggghts/restart_state.cpp plugins/liggghts/run_chunks.cpp plugins/liggghts/input_loop.cpp -o "$helper" -Wl,--no-as-needed -lliggghts -lmpi
+    flags=(-O2 -fPIC -DOMPI_SKIP_MPICXX -I/usr/include/liggghts
+           $(pkg-config --cflags ompi 2>/dev/null || echo -I/usr/lib/x86_64-linux-gnu/openmpi/include))
+    objects=()
+    pids=()
+    for src in plugins/liggghts/*.cpp; do            # each source on a core of its own, then linked
+        obj=$out/lib/$(basename "${src%.cpp}").o
+        g++ "${flags[@]}" -c "$src" -o "$obj" & pids+=($!)
+        objects+=("$obj")
+    done
+    for pid in "${pids[@]}"; do wait "$pid"; done
+    g++ -shared "${objects[@]}" -o "$helper" -Wl,--no-as-needed -lliggghts -lmpi
+    rm -f "${objects[@]}"
     done_build liggghts
 fi
 
@@ -101,12 +110,8 @@ if changed openfoam plugins/openfoam "$solver"; then
         set -e
         export COLLHEAT_BIN=$out/bin
         cd plugins/openfoam/collheatFoam
-        wmake > "$out/log.wmake" 2>&1 || { tail -30 "$out/log.wmake" >&2; exit 1; }
+        WM_NCOMPPROCS=2 wmake > "$out/log.wmake" 2>&1 || { tail -30 "$out/log.wmake" >&2; exit 1; }
     )
     done_build openfoam
 fi
-# mpi4py for the host under mpirun: Debian's, built against the same OpenMPI as LIGGGHTS
-# (a PyPI wheel may bring another MPI). Only that package is linked into .venv.
-site=$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
-[ -e "$site/mpi4py" ] || ln -s /usr/lib/python3/dist-packages/mpi4py "$site/mpi4py"
 echo "setup_engines: ready (solver $solver, helper $helper)"

@@ -25,6 +25,7 @@ def run(case: str, out, harvest_every: int, monkeypatch, **time):
     return summary, list(csv.DictReader(open(out / "collisions.csv"))), list(csv.DictReader(open(out / "history.csv")))
 
 
+@pytest.mark.long
 def test_without_heat_gran_the_delay_changes_nothing(tmp_path, monkeypatch):
     """hot-cold-box, 10 ms (a dense granular gas, no fix heat/gran, no convection): nothing but
     the host changes a temperature between two harvests, and the host moves a batch's heat

@@ -26,6 +26,7 @@ def gidaspow_gradient(alpha, q, rho=1.2, mu=1.2e-5, d=2.5e-3):
     return np.where(alpha < 0.8, ergun, wen_yu) * q / alpha**2
 
 
+@pytest.mark.long
 def test_bed_25k_smoke_keeps_its_beads_and_brackets_the_bed_drop(tmp_path):
     """-test (10 ms, 24,750 beads, about 25 s): no bead lost, energy balance exact, and the gas
     pressure drop across the still loose lattice between the two bounds of a heterogeneous

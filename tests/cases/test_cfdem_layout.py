@@ -121,6 +121,7 @@ def test_time_end_and_test_cut_the_driven_run(tmp_path):
     assert velocities(cfd)[-1, 0] == pytest.approx(0.005)
 
 
+@pytest.mark.long
 def test_a_coupling_interval_longer_than_the_cases_deltaT_runs_in_its_steps(tmp_path):
     """The case's controlDict asks deltaT = 0.25 ms, a quarter of the coupling interval (100
     DEM steps of 10 us): the fluid advances each interval in 4 steps of 0.25 ms (as CFDEM's
@@ -156,6 +157,7 @@ def test_a_dry_script_whose_runs_simulate_nothing_is_refused(tmp_path):
     assert "the script's runs simulate no step" in r.stderr and "in.liggghts_run:" in r.stderr
 
 
+@pytest.mark.long
 def test_cfdem_layout_stopped_and_restarted_is_the_run_never_stopped(tmp_path):
     """The user's OpenFOAM case and script stopped by SIGTERM at step 5003 of the driven
     ``run 0 upto`` (no output.checkpoint: the signal writes one at the end of the coupling
@@ -417,6 +419,7 @@ def test_a_second_stage_goes_on_from_the_first_stages_fluid_and_dem(tmp_path):
     assert vz[-1] == pytest.approx(vz1[-1], rel=1e-4)
 
 
+@pytest.mark.long
 @pytest.mark.skipif(shutil.which("mpirun") is None, reason="no mpirun: tools/setup.sh --engines")
 def test_the_cases_liggghtsCommands_on_two_ranks_as_serially(tmp_path):
     """The same liggghtsCommands under ``mpirun -np 2`` (LIGGGHTS' domain split, the commands

@@ -100,6 +100,7 @@ def test_a_collision_owns_its_contact_for_t_coll(tmp_path):
         assert abs(s["energy_balance_error"]) < 1e-12
 
 
+@pytest.mark.long
 def test_conduction_stopped_within_t_coll_restarts_bit_for_bit(tmp_path):
     """The collision-and-contact run above stopped by SIGTERM at step 2540, inside the
     collision's t_coll (it began at step 2501 and owns its contact to step 2572), and restarted

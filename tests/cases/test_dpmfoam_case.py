@@ -24,6 +24,7 @@ from dpmfoam_as_is import dpmfoam, import_case, tutorial  # noqa: E402
 BEADS, END, G = 2500, 0.006, 9.81
 
 
+@pytest.mark.long
 def test_imported_goldschmidt_runs_with_its_inlet_and_falls_as_in_dpmfoam(tmp_path):
     """The host's run of the imported tutorial (``--hot-below 0.012``: its four lowest layers
     start at 400 K, the rest at 300 K, a temperature per atom type, each type a temperature group

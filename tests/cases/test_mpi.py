@@ -68,6 +68,7 @@ def test_contact_events_of_a_pair_across_the_rank_boundary_equal_the_serial_run(
         assert (tmp_path / "np2" / name).read_bytes() == (tmp_path / "np1" / name).read_bytes(), name
 
 
+@pytest.mark.long
 def test_granular_gas_on_two_ranks(tmp_path):
     """hot-cold-box's smoke run (1000 spheres, periodic): the same collisions within the
     chaos of the gas (the order of the force sums differs, so rounding does), and the heat
@@ -86,6 +87,7 @@ def test_granular_gas_on_two_ranks(tmp_path):
 
 
 
+@pytest.mark.long
 def test_poured_silo_on_two_ranks(tmp_path):
     """silo-heat --test (900 spheres poured into an STL tube onto a shaken plate, fix
     heat/gran) on two ranks split across z, each rank recording its own contacts. Settling
@@ -250,6 +252,7 @@ def box_variant(tmp_path, old, new, extra=""):
     return case
 
 
+@pytest.mark.long
 def test_box_with_a_hot_wall_moves_heat_on_each_rank_as_rank_0_does(tmp_path):
     """hot-cold-box --test closed in z by a wall at 500 K below and an adiabatic one above, on
     two ranks (frames every 10,000 steps: nine of its ten harvests come alone): each rank
@@ -277,6 +280,7 @@ material = "steel"
     assert np.abs(a["Q"] - b["Q"]).max() <= 1e-4 * np.abs(b["Q"]).max()
 
 
+@pytest.mark.long
 def test_restitution_feedback_with_heat_on_each_rank_as_rank_0_gives_it(tmp_path):
     """hot-cold-box --test with restitution feedback (harvests every 10 steps) on two ranks:
     each rank moving its own collisions' heat (its batches of about 6 collisions too, which a
@@ -297,6 +301,7 @@ def test_restitution_feedback_with_heat_on_each_rank_as_rank_0_gives_it(tmp_path
         assert r["status"] == "completed" and abs(r["energy_balance_error"]) < 1e-12
 
 
+@pytest.mark.long
 def test_fluidized_bed_moves_heat_on_each_rank_at_its_exchanges(tmp_path):
     """hot-cold-bed --test (LIGGGHTS on two ranks, the fluid on one) on two ranks: its harvests
     come every 1,000 steps (alone: its fluid exchanges read no temperature) and at frames,
@@ -317,6 +322,7 @@ def test_fluidized_bed_moves_heat_on_each_rank_at_its_exchanges(tmp_path):
         assert np.nanmax(np.abs(a[column] - b[column])) < 1e-9, column
 
 
+@pytest.mark.long
 def test_heat_sources_on_two_ranks_sum_as_serially(tmp_path):
     """Debian's heatTransfer_2 (heat/gran's per-atom heat sources) on two ranks: each rank's
     recorder sums the heat its own atoms' sources put in, and rank 0 adds them up:
@@ -360,6 +366,7 @@ def test_killed_two_rank_run_restarts_from_its_checkpoint_exactly(tmp_path):
     assert_continued(serial, whole)
 
 
+@pytest.mark.long
 def test_finished_two_rank_run_extended_is_the_longer_run(tmp_path):
     """hot-cold-box --test (10 ms) on two ranks with a checkpoint every 5 ms ends in one at its
     end; --restart --extend 0.005 on two ranks gives byte for byte (collisions.csv,
@@ -392,6 +399,7 @@ def assert_continued(restarted, whole):
     assert restarted["heat_moved"] == pytest.approx(whole["heat_moved"], rel=0.02)
 
 
+@pytest.mark.long
 def test_serial_checkpoint_continues_on_two_ranks(tmp_path):
     """hot-cold-box --test killed at step 6003 on one rank, continued from its 4 ms checkpoint
     with mpirun -np 2."""
@@ -407,6 +415,7 @@ def test_serial_checkpoint_continues_on_two_ranks(tmp_path):
     assert_continued(restarted, whole)
 
 
+@pytest.mark.long
 def test_script_on_two_ranks_stopped_while_pouring_restarts_bit_for_bit(tmp_path):
     """cases/silo-heat --test (a user's script: insertion, an STL tube, a shaken plate) on two
     ranks with a checkpoint every 6005 steps, stopped by SIGTERM at step 6003 and restarted on

@@ -11,7 +11,7 @@ import pytest
 from pyhost.fluidization import measure
 from pyhost.scene import load_scene
 
-pytestmark = pytest.mark.engines
+pytestmark = [pytest.mark.engines, pytest.mark.long]   # a validation of the fluid: about 20 s
 CASE = Path(__file__).resolve().parents[2] / "cases" / "packed-bed-ergun"
 
 

@@ -64,6 +64,7 @@ def test_control_flow_runs_as_in_plain_liggghts(tmp_path, flow):
     assert s["collisions"] >= 9 and abs(s["energy_balance_error"]) < 1e-12
 
 
+@pytest.mark.long
 def test_a_restart_inside_a_loop_goes_on_where_the_loop_stood(tmp_path):
     """The loop left by an 'if' (four runs of 100 steps, its variable at 2 of 10 when stopped)
     with a checkpoint every 1 ms, stopped by SIGTERM at step 250 and restarted: the restart
@@ -76,7 +77,7 @@ def test_a_restart_inside_a_loop_goes_on_where_the_loop_stood(tmp_path):
     assert whole["steps"] == 350 and "restarted in this run, 50 steps to go" in said
 
 
-@pytest.mark.parametrize("flow", ["loop", "if_runs"])
+@pytest.mark.parametrize("flow", ["loop", pytest.param("if_runs", marks=pytest.mark.long)])
 def test_control_flow_on_two_ranks_is_the_serial_run(tmp_path, flow):
     """Under mpirun -np 2 every rank follows rank 0's input loop (the if's branch is LIGGGHTS'
     on all ranks, the next's on each): the same steps and collisions.csv byte for byte."""

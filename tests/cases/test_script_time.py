@@ -119,6 +119,7 @@ def collision(row) -> tuple:
     return (float(row["time"]),) + ((min(i, j), max(i, j)) if j else (i, 0))
 
 
+@pytest.mark.long
 def test_post_places_the_dumps_in_the_scripts_runs(tmp_path):
     """post --script on the dumps of the same run (positions at every step, one file through
     the reset): it reads the script's time steps and reset, so it accepts the frames whose

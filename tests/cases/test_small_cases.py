@@ -160,6 +160,7 @@ def test_hot_cold_gas_bed_smoke_run_keeps_particles_and_gas_energy(tmp_path):
     assert abs(summary["total_energy_balance_error"]) < 1e-12
 
 
+@pytest.mark.long
 def test_fluid_beside_the_dem_gives_the_same_run(tmp_path):
     """cases/hot-cold-gas-bed -test (convection: the gas's temperature and boundary heat are
     read after each advance) with the fluid advancing while the DEM runs ([fluid] overlap =

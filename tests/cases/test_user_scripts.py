@@ -39,6 +39,7 @@ def run(case: Path, *extra):
     return r, json.loads(summary.read_text()) if summary.exists() else None
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not TUTORIAL.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
 def test_debian_heat_transfer_tutorial_runs_unchanged(tmp_path):
     """in.heatGran pours 890 steel spheres into a cylinder (primitive walls, insert/pack,
@@ -100,6 +101,7 @@ def source_heat_expected(log: Path, steps_after_set: int, dt: float = 2.5e-5) ->
     return (made[0] - made[1]) * 1.5 * steps_after_set * dt
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not SOURCES.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
 def test_debian_heat_source_tutorial_closes_its_balance_with_the_sources_heat(tmp_path):
     """The heat heat/gran's sources put in is a term of the energy balance
@@ -174,6 +176,7 @@ def test_a_hot_script_wall_in_the_scene_gets_collision_heat_and_heat_grans_share
     assert f"in.heatGran:{line})" in r.stderr, r.stderr          # the wall fix's own line
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not SOURCES.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
 def test_heat_gran_script_with_sources_restarts_bit_for_bit(tmp_path):
     """heatTransfer_2 (fix heat/gran conducting, its sources on) stopped by SIGTERM at 0.5625 s,
@@ -211,6 +214,7 @@ def restarts_bit_for_bit(case: Path, end: tuple, checkpoint: float, said: str, s
     return whole
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not TUTORIAL.is_dir(), reason="liggghts-doc is installed by tools/setup_engines.sh")
 def test_hot_script_wall_take_back_restarts_bit_for_bit(tmp_path):
     """heatTransfer_1 with its 1000 K floor in the script and in [[walls]] (heat/gran's share of
@@ -337,6 +341,7 @@ run 10""")
     assert "atom type(s) [2] have no material" in r.stderr and "Traceback" not in r.stderr
 
 
+@pytest.mark.long
 def test_silo_with_the_users_openfoam_case(tmp_path):
     """The same script with gas up through the user's hand-written OpenFOAM case (fluid/):
     the host copies the case, collheatFoam solves it, the particles feel it, the balance

@@ -503,6 +503,7 @@ def fluid_outputs(out: Path) -> dict:
     return found
 
 
+@pytest.mark.long
 def test_gas_bed_killed_and_restarted_from_its_checkpoint_is_exact(tmp_path):
     """hot-cold-gas-bed --test (3000 spheres fluidized by gas that exchanges heat with them, 20 ms)
     with a checkpoint every 8 ms, killed outright at step 3003 and continued from the checkpoint
@@ -523,6 +524,7 @@ def test_gas_bed_killed_and_restarted_from_its_checkpoint_is_exact(tmp_path):
     assert abs(summary(out)["total_energy_balance_error"]) < 1e-12
 
 
+@pytest.mark.long
 def test_bed_stopped_by_sigterm_without_checkpoints_restarts(tmp_path):
     """hot-cold-bed --test as it is (no output.checkpoint): SIGTERM at step 6253 still writes a
     checkpoint where the run stops (step 6275, the end of the coupling interval under way) and

@@ -51,8 +51,8 @@ def assert_failed(r, *words):
         assert w in r.stderr, (w, r.stderr[-2000:])
 
 
-@pytest.mark.parametrize("ranks", [1, pytest.param(2, marks=pytest.mark.skipif(
-    shutil.which("mpirun") is None, reason="no mpirun: tools/setup.sh --engines"))])
+@pytest.mark.parametrize("ranks", [1, pytest.param(2, marks=[pytest.mark.long, pytest.mark.skipif(
+    shutil.which("mpirun") is None, reason="no mpirun: tools/setup.sh --engines")])])
 def test_particle_leaving_through_an_open_face(tmp_path, ranks):
     """Also on two ranks, where each keeps its own particles' positions before each chunk and
     rank 0 gathers them only for the report."""
@@ -61,6 +61,7 @@ def test_particle_leaving_through_an_open_face(tmp_path, ranks):
     assert "stopped at t = " in (tmp_path / "out" / "summary.json").read_text()
 
 
+@pytest.mark.long
 def test_particle_tunnelling_through_a_soft_wall(tmp_path):
     """5 MPa (LIGGGHTS' least modulus) and 30 m/s: the Hertz overlap would be 5 mm > R = 2 mm."""
     r = run(tmp_path, one_particle(30.0, youngs=5e6, walls=["xhi"], dem_step=1e-7))
