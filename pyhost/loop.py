@@ -37,6 +37,7 @@ from pyhost.effects.collisions import CollisionHeat
 from pyhost.effects.conduction import LastingConduction
 from pyhost.effects.fluid import FluidExchange
 from pyhost.effects.frames import Frames
+from pyhost.effects.probes import Probes
 from pyhost.engines.dem import Dem
 from pyhost.engines.liggghts import LiggghtsError
 from pyhost.failures import InvariantBroken, particles_lost
@@ -128,12 +129,13 @@ class Coupling:
         # the effects the scene asks for, in the order they act
         self.balance = EnergyBalance(self) if self.heat else None
         self.collisions = CollisionHeat(self, walls, logs) if self.effects["contact_extraction"] else None
-        self.conduction = LastingConduction(self) if self.effects["conduction"] else None
+        self.conduction = LastingConduction(self, walls) if self.effects["conduction"] else None
         self.check_heat_gran()
         if resume is None and self.balance is not None:
             self.balance.begin(dem.atoms(True))
         self.fluid_exchange = FluidExchange(self, fluid, logs) if fluid is not None else None
         self.frames = Frames(self, [self.fluid_exchange] if fluid is not None else [], logs)
+        self.probes = Probes(self, logs) if scene.output.probes else None
         self.progress = Progress(end or math.inf, progress_every)
         events = self.collisions is not None
         self.every = dict(harvest=(scene.time.sample_every if self.collisions.restitution else HARVEST_EVERY)
@@ -146,7 +148,7 @@ class Coupling:
         self.case_commands = (case_commands(self, driven) if fluid is not None and scene.fluid.case  # a user's case's:
                               else None)                  # after the DEM's steps, before the fluid's exchange
         self.effect_list = [e for e in (self.balance, self.collisions, self.conduction, self.case_commands,
-                                        self.fluid_exchange, self.frames) if e is not None]
+                                        self.fluid_exchange, self.frames, self.probes) if e is not None]
         if events:                           # the walls' contacts now are open ones: one that begins at
             dem.events.sync()                # the next step is a collision (prepare's set-up left the lists)
         self.program, self.run_left = None, 0  # the script's input loop (Program: where it stands at the run
@@ -183,6 +185,8 @@ class Coupling:
         """The LIGGGHTS walls as the host sees them (a script may add walls between runs)."""
         if self.collisions is not None:
             self.collisions.update_walls(walls)
+        if self.conduction is not None:
+            self.conduction.update_walls(walls)
 
     def check_heat_gran(self) -> None:
         """At each of a script's runs: its fix heat/gran checked against the scene."""
@@ -569,4 +573,7 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, f
         raise
     if coupling is None:
         raise ScriptError(f"{scene.path}: the script has no 'run' command: nothing to simulate")
+    if scene.frozen.end > 0:                  # the bed frozen where the runs left it: heat alone
+        from pyhost.frozen import frozen_stage
+        frozen_stage(coupling, log=log)
     return coupling.finish()
