@@ -240,6 +240,10 @@ def load_scene(path) -> Scene:
     conduction = _conduction(effects, build(Conduction, data.get("conduction", {}), "conduction", file), fluid, file)
     for name, region in output.probes.items():
         _box(region if isinstance(region, list) else [region], f"output.probes.{name}", file)
+    if output.probes and not (effects.heat_models or effects.convection != "none"
+                              or effects.contact_conduction != "none" or effects.gap_conduction != "none"):
+        raise SceneError(f"{file}: output.probes: the particles have no temperatures in this scene (no contact "
+                         "heat, convection or conduction): nothing to probe")
     frozen = build(Frozen, data.get("frozen", {}), "frozen", file)
     if frozen.end > 0 and effects.contact_conduction == "none" and effects.gap_conduction == "none":
         raise SceneError(f"{file}: frozen.end: a frozen stage moves heat through lasting conduction only: give "
