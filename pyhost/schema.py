@@ -109,6 +109,10 @@ class Material:
     yield_stress: float = spec(">0", doc="[Pa]")
     heat_capacity: float = spec(">0", doc="[J/(kg K)]")
     conductivity: float = spec(">0", doc="[W/(m K)]")
+    roughness: float = spec(">=0", 0.0, "RMS surface roughness [m], for contact_conduction = \"lethe_rough\" "
+                                        "(0: smooth)")
+    surface_slope: float = spec(">=0", 0.0, "RMS surface slope [-], for contact_conduction = \"lethe_rough\"")
+    microhardness: float = spec(">=0", 0.0, "microhardness [Pa], for contact_conduction = \"lethe_rough\"")
     dem: DemContact | None = spec(default=None, doc="the DEM's softened contact: required for box scenes; a "
                                                   "script scene reads it from the script's fix property/global "
                                                   "(checked against this table if given)")

@@ -79,6 +79,14 @@ class LastingConduction(Effect):
         softened = [m.dem for m in mats]      # the DEM's contact of each material (None: in no pair)
         self.E_dem = np.array([[effective_modulus(a.youngs_modulus, a.poisson_ratio, b.youngs_modulus, b.poisson_ratio)
                                 if a and b else np.nan for b in softened] for a in softened])
+        self.sigma = np.array([getattr(m, "roughness", 0.0) for m in mats])
+        self.slope = np.array([getattr(m, "surface_slope", 0.0) for m in mats])
+        self.hardness = np.array([getattr(m, "microhardness", 0.0) for m in mats])
+        if fx.contact_conduction == "lethe_rough":
+            for m, name in zip(mats, scene.materials):
+                if not (m.roughness > 0 and m.surface_slope > 0 and m.microhardness > 0):
+                    raise ScriptError(f"{scene.path}: materials.{name}: contact_conduction = \"lethe_rough\" needs "
+                                      "its roughness, surface_slope and microhardness (> 0)")
         self.t_last = loop.t
         self.owned = {}
         self.update_walls(walls)
@@ -146,7 +154,7 @@ class LastingConduction(Effect):
         if len(i):
             mi, mj = loop.materials_of(atoms.type[i]), loop.materials_of(atoms.type[j])
             pair = Pair(atoms.radius[i], atoms.radius[j], dist, self.k[mi], self.k[mj], self.E_dem[mi, mj],
-                        self.E_real[mi, mj])
+                        self.E_real[mi, mj], *self.surfaces(mi, mj))
             pairs = self._links((i, j), pair)
         p, T_w, Hc, Hg = [np.zeros(0, int)], [zero], [zero], [zero]
         if self.walls and len(atoms.id):
@@ -158,13 +166,21 @@ class LastingConduction(Effect):
                 R = WALL_RADIUS * r
                 m = mat[at]
                 pair = Pair(r, R, r + R - delta[at], self.k[m], self.k[w.material], self.E_dem[m, w.material],
-                            self.E_real[m, w.material])
+                            self.E_real[m, w.material], *self.surfaces(m, w.material))
                 at, hc, hg = self._links((at,), pair)
                 p.append(at)
                 T_w.append(np.full(len(at), w.temperature))
                 Hc.append(hc)
                 Hg.append(hg)
         return pairs, (np.concatenate(p), np.concatenate(T_w), np.concatenate(Hc), np.concatenate(Hg))
+
+    def surfaces(self, mi, mj):
+        """Equivalent roughness [m], slope [-] and effective microhardness [Pa] of the pairs of
+        materials mi, mj, as Lethe combines them (``plugins.conduction.Pair``)."""
+        Hi, Hj = self.hardness[mi], self.hardness[mj]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            H = np.where(Hi + Hj > 0, 2.0 * Hi * Hj / (Hi + Hj), 0.0)
+        return np.hypot(self.sigma[mi], self.sigma[mj]), np.hypot(self.slope[mi], self.slope[mj]), H
 
     def _links(self, index, pair):
         """(index arrays, H_contact, H_gap) [W/K] of the links of ``pair``, those with H = 0 dropped."""
