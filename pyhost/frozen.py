@@ -54,8 +54,9 @@ def integrate(C, pairs, walls, T0, end: float, step: float, method: str = "impli
     """Integrate the frozen network (the module doc) from temperatures ``T0`` [K] for ``end``
     [s] at steps of at most ``step`` [s] (end is a whole number of steps). ``on_row(t, T)`` is
     called every ``every`` [s] (0: every 10 steps) and at the end. Returns (T, Q_walls [J], dt,
-    steps): the final temperatures, the heat the walls gave and the step taken. ScriptError for
-    an explicit step above its bound."""
+    steps): the final temperatures, the heat the walls gave and the step taken. ``on_row`` gets
+    (t, T, Q) with Q the walls' heat so far [J]. ScriptError for an explicit step above its
+    bound."""
     from scipy.sparse.linalg import splu
 
     C = np.asarray(C, float)
@@ -83,7 +84,7 @@ def integrate(C, pairs, walls, T0, end: float, step: float, method: str = "impli
             T = lu.solve(C / dt * T + b)
             Q += dt * float(np.sum(H_w * (T_w - T[p])))
         if on_row is not None and (k % row_every == 0 or k == steps):
-            on_row(k * dt, T)
+            on_row(k * dt, T, Q)
     return T, Q, dt, steps
 
 
@@ -111,9 +112,12 @@ def frozen_stage(loop, log=print) -> None:
     t0 = loop.t
     start = time.perf_counter()
 
-    def on_row(t, T):
+    Q_before = (loop.totals["heat_from_walls"], loop.totals["heat_conducted_wall"])
+
+    def on_row(t, T, Q):
         atoms.T[:] = T
         loop.t = t0 + t
+        loop.totals["heat_from_walls"], loop.totals["heat_conducted_wall"] = (q + Q for q in Q_before)
         loop.write_frame()
 
     T, Q, dt, steps = integrate(C, (i, j, H), (p, T_w, Wc + Wg), atoms.T, fz.end, fz.step, fz.method, fz.every,
@@ -121,8 +125,7 @@ def frozen_stage(loop, log=print) -> None:
     atoms.T[:] = T
     loop.t = t0 + fz.end
     cond.t_last = loop.t
-    loop.totals["heat_from_walls"] += Q
-    loop.totals["heat_conducted_wall"] += Q
+    loop.totals["heat_from_walls"], loop.totals["heat_conducted_wall"] = (q + Q for q in Q_before)
     seconds = time.perf_counter() - start
     loop.totals["frozen_stage"] = dict(start=t0, end=loop.t, step=dt, steps=steps, method=fz.method,
                                        pairs=int(len(i)), pairs_in_contact=int(np.count_nonzero(Hc)),

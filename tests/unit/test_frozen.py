@@ -61,7 +61,7 @@ def test_explicit_refused_above_its_bound_and_implicit_stable_there():
 def test_rows_every_and_at_the_end():
     C, pairs, walls, T0 = chain()
     times = []
-    integrate(C, pairs, walls, T0, 10.0, 0.3, "implicit", every=3.0, on_row=lambda t, T: times.append(t))
+    integrate(C, pairs, walls, T0, 10.0, 0.3, "implicit", every=3.0, on_row=lambda t, T, Q: times.append(t))
     # 34 steps of 10/34 s: a row every 10 steps (2.94 s) and one at the end
     assert np.allclose(times, [k * 10.0 / 34 for k in (10, 20, 30, 34)])
 
