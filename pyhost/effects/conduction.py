@@ -217,6 +217,10 @@ class LastingConduction(Effect):
             self.loop.totals["heat_conducted_gap"] += float(np.abs(qp * (1.0 - share)).sum())
             self.loop.totals["heat_conducted_wall"] += float(qw.sum())
             self.loop.totals["heat_from_walls"] += float(qw.sum())
+            # the balance sees the temperatures as moved here: the next run's resync must not count
+            # this interval's wall heat again as set by the script (the end of a run conducts after
+            # the balance's last look)
+            loop.track_particles(atoms)
         self.owned = {k: end for k, end in self.owned.items() if end > t1}
 
     def contact_time(self, ids_i, ids_j, t0: float, t1: float) -> np.ndarray:

@@ -1,6 +1,6 @@
 """cases/heated-packed-bed: Beaulieu's heated packed bed as Lethe sets it up. The smoke run
-(-test: 400 beads, 0.1 s of pour, then the 4000 s frozen stage) in the default suite; the full
-case (8849 beads) behind the ``validation`` marker (``pytest -m validation``, about 3-5 min)."""
+(-test: 400 beads, a few ms of DEM, then the 4000 s frozen stage) in the default suite; the full
+case (8849 beads) behind the ``validation`` marker (``pytest -m validation``, about 6-7 min)."""
 import csv
 import json
 import subprocess
@@ -52,13 +52,13 @@ def test_full_case_runs_in_15_minutes_with_its_balance_closed(full):
     out, summary, seconds = full
     print(f"heated packed bed: {seconds:.0f} s, frozen stage {summary['frozen_stage']}")
     assert seconds < 15 * 60
-    assert summary["frozen_stage"]["pairs_in_contact"] > 15000 and summary["frozen_stage"]["wall_links"] > 100
+    assert summary["frozen_stage"]["pairs_in_contact"] > 15000 and summary["frozen_stage"]["wall_links"] > 50
     assert abs(summary["energy_balance_error"]) < 1e-9
 
 
 @pytest.mark.validation
-@pytest.mark.xfail(strict=True, reason="measured: 2.5-3.3 K above the experiment at its worst (README.md): "
-                                       "an honest miss of the 1.5 K goal, nothing fitted")
+@pytest.mark.xfail(strict=True, reason="measured: 40 mm misses (worst 2.48 K, 1.2 K too cold on "
+                                       "average); 60 and 73 mm within (1.10, 0.74 K): README.md; nothing fitted")
 def test_full_case_within_1_5_K_of_the_experiment_after_900_s(full):
     """The issue's goal: every experimental point after 900 s within 1.5 K, at 40, 60, 73 mm."""
     out, summary, seconds = full
