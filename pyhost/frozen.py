@@ -20,7 +20,8 @@ zero), b_i = sum_w H_iw T_w. Integrated by
 
 The balance closes by construction: since L's columns sum to zero, sum_i C_i (T^{n+1} - T^n)
 = dt sum_w H_iw (T_w - T_i^*) (T^* = T^{n+1} implicit, T^n explicit), which is what is added to
-``heat_from_walls`` (and ``heat_conducted_wall``) step by step. The temperatures go back into
+``heat_from_walls`` (and ``heat_conducted_wall``) step by step; ``heat_conducted_contact`` and
+``heat_conducted_gap`` keep the DEM's part only (the stage's pair heat is not split by path). The temperatures go back into
 LIGGGHTS' Temp and the run's time goes on by ``end``; frames (history.csv, VTK, probes.csv)
 are written every ``[frozen] every``. The gas is not integrated: a scene with a fluid is
 refused (the fluid's own energy equation is not frozen with the bed).
