@@ -2,7 +2,7 @@
 ``run N`` commands N coupled steps of ``pyhost.loop.Coupling``: the script's own commands go to
 the DEM (``Dem.commands``, ``Dem.branch``, ``Dem.jump_skipped``), the host's fixes go in before
 the first run (``Dem.prepare``), a restart replays the commands the checkpoint's run had run
-(``pyhost.script.replay``), the last run is extended (``--extend``) or driven by a CFD-DEM
+(``pyhost.engines.liggghts.script.replay``), the last run is extended (``--extend``) or driven by a CFD-DEM
 coupling, and a run that stops still writes its summary and, at a signal, a checkpoint."""
 from __future__ import annotations
 
@@ -228,4 +228,15 @@ def run_scene(scene, dem: Dem, commands, out: Path, *, walls_of, script: Path, f
         raise
     if coupling is None:
         raise ScriptError(f"{scene.path}: the script has no 'run' command: nothing to simulate")
+    if scene.frozen.end > 0:                  # the bed frozen where the runs left it: heat alone
+        from pyhost.frozen import frozen_stage
+        try:
+            frozen_stage(coupling, log=log)
+        except BaseException as exc:          # what came before stays: its summary, then the error
+            try:
+                coupling.finish(status=f"stopped in the frozen stage at t = {coupling.t:g} s by "
+                                       f"{type(exc).__name__}: {exc}")
+            except Exception as err:
+                log(f"warning: no summary.json ({type(err).__name__}: {err})")
+            raise
     return coupling.finish()

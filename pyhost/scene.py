@@ -51,7 +51,7 @@ import tomllib
 from pathlib import Path
 
 from plugins.heat import MODELS
-from pyhost.schema import (Conduction, Dem, Domain, Effects, Fluid, Material, Output, Particles,  # noqa: F401
+from pyhost.schema import (Conduction, Dem, Domain, Effects, Fluid, Frozen, Material, Output, Particles,  # noqa: F401
                            check_types, Scene, SceneError, Time, Wall, build)   # the schema's names, re-exported for the commands
 from pyhost.validate import check_scene
 from pyhost.engines.liggghts.names import CONDUCTION_FIX, COUPLING_FIX, WALL_FIX
@@ -80,7 +80,7 @@ def _inlet_table(fluid, file):
         raise SceneError(f"{key}: times must increase, got {times!r}")
 
 
-SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output", "dem", "conduction")
+SECTIONS = ("effects", "materials", "particles", "domain", "time", "walls", "fluid", "output", "dem", "conduction", "frozen")
 
 
 def read_text(path) -> str:
@@ -112,7 +112,7 @@ def _finite(value, key, file) -> None:
 
 def check_raw(data: dict, file: str) -> None:
     """Shapes the scene builder relies on, and finite numbers everywhere."""
-    for key in ("materials", "domain", "time", "effects", "fluid", "output", "conduction"):
+    for key in ("materials", "domain", "time", "effects", "fluid", "output", "conduction", "frozen"):
         if key in data and not isinstance(data[key], dict):
             raise SceneError(f"{file}: {key}: must be a table [{key}], got {data[key]!r}")
     for name, m in data.get("materials", {}).items():
@@ -229,7 +229,17 @@ def load_scene(path) -> Scene:
         _inlet_table(fluid, file)
     output = build(Output, data.get("output", {}), "output", file)
     conduction = _conduction(effects, build(Conduction, data.get("conduction", {}), "conduction", file), fluid, file)
-    scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem, conduction)
+    for name, region in output.probes.items():
+        _box(region if isinstance(region, list) else [region], f"output.probes.{name}", file)
+    if output.probes and not (effects.heat_models or effects.convection != "none"
+                              or effects.contact_conduction != "none" or effects.gap_conduction != "none"):
+        raise SceneError(f"{file}: output.probes: the particles have no temperatures in this scene (no contact "
+                         "heat, convection or conduction): nothing to probe")
+    frozen = build(Frozen, data.get("frozen", {}), "frozen", file)
+    if frozen.end > 0 and effects.contact_conduction == "none" and effects.gap_conduction == "none":
+        raise SceneError(f"{file}: frozen.end: a frozen stage moves heat through lasting conduction only: give "
+                         "effects.contact_conduction or effects.gap_conduction")
+    scene = Scene(path, effects, materials, particles, domain, time, walls, fluid, output, dem, conduction, frozen)
     check_scene(scene)
     return scene
 

@@ -120,6 +120,10 @@ class Material:
                                                           "scenes), or a list, one per entry of types (each "
                                                           "type then a temperature group of its own in "
                                                           "history.csv); 0 keeps the script's own Temp values")
+    roughness: float = spec(">=0", 0.0, "RMS surface roughness [m], for contact_conduction = \"lethe_rough\" "
+                                        "(0: smooth)")
+    surface_slope: float = spec(">=0", 0.0, "RMS surface slope [-], for contact_conduction = \"lethe_rough\"")
+    microhardness: float = spec(">=0", 0.0, "microhardness [Pa], for contact_conduction = \"lethe_rough\"")
 
     def temperature_of(self, atom_type: int) -> float:
         """The initial temperature [K] of this material's atoms of that type (0: the script's)."""
@@ -296,6 +300,22 @@ class Output:
                            "one raw little-endian file per column in OUT/collisions/ with schema.json (cheaper "
                            "to write; read with pyhost.output.read_collisions, convert with "
                            "'python -m pyhost collisions OUT')")
+    probes: dict = spec(default={}, doc="probes: NAME = [xmin, xmax, ymin, ymax, zmin, zmax] [m], a region whose "
+                        "particles' mean temperature (by heat capacity) goes to OUT/probes.csv, column NAME [K], at "
+                        "every frame and every frozen.every of a frozen stage (NaN: no particle centre in it)")
+
+
+@dataclass(frozen=True)
+class Frozen:
+    end: float = spec(">=0", 0.0, "duration of the frozen-bed thermal stage after the script's last run [s]: the "
+                                  "particles stay where the DEM left them and only heat moves, through the "
+                                  "conduction models of [effects] and the walls at a temperature (pyhost/frozen.py); "
+                                  "0: no frozen stage")
+    step: float = spec(">0", 1.0, "thermal time step of the frozen stage [s]")
+    every: float = spec(">=0", 0.0, "interval between the frozen stage's probe rows [s]; 0: every 10 steps")
+    method: str = spec("in:implicit,explicit", "implicit",
+                       "implicit: backward Euler, a sparse solve per step (stable at any step); explicit: forward "
+                       "Euler, refused when the step exceeds its stability bound min(C_i / sum_j H_ij)")
 
 
 @dataclass(frozen=True)
@@ -311,6 +331,7 @@ class Scene:
     output: Output
     dem: Dem = Dem()
     conduction: Conduction = Conduction()
+    frozen: Frozen = Frozen()
 
     @property
     def folder(self) -> Path:

@@ -35,6 +35,10 @@ SECTIONS = (
     ("[conduction]", S.Conduction, "Lasting conduction between particles (effects.contact_conduction, "
                                    "effects.gap_conduction: plugins/conduction): how often it is updated, the gas "
                                    "in the gaps and the gap models' cut-offs. Used only when a model is asked for."),
+    ("[frozen]", S.Frozen, "The frozen-bed thermal stage after the script's last run (pyhost/frozen.py): the "
+                           "particles stay where the DEM left them and heat moves through the lasting conduction "
+                           "network and the walls at a temperature, at thermal steps set for heat alone. Needs "
+                           "effects.contact_conduction or effects.gap_conduction; not with a fluid."),
     ("[output]", S.Output, "What a run writes."),
 )
 

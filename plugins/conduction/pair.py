@@ -12,7 +12,11 @@ class Pair(NamedTuple):
     r_i, r_j [m]: radii; distance [m]: between the centres (overlap r_i + r_j - distance);
     k_i, k_j [W/(m K)]: the real materials' conductivities; E_dem [Pa]: the effective modulus
     E* = [(1 - nu_i^2)/E_i + (1 - nu_j^2)/E_j]^-1 of the DEM's (softened) contact, E_real [Pa]
-    that of the real materials (used by the models that correct the softened overlap)."""
+    that of the real materials (used by the models that correct the softened overlap).
+    roughness [m], slope [-], microhardness [Pa]: the surfaces' equivalent RMS roughness
+    (sigma_i^2 + sigma_j^2)^(1/2), equivalent RMS slope (m_i^2 + m_j^2)^(1/2) and effective
+    microhardness 2 H_i H_j / (H_i + H_j), as Lethe combines them (0: smooth; the rough
+    contact models only)."""
 
     r_i: np.ndarray
     r_j: np.ndarray
@@ -21,6 +25,9 @@ class Pair(NamedTuple):
     k_j: np.ndarray
     E_dem: np.ndarray
     E_real: np.ndarray
+    roughness: np.ndarray | float = 0.0
+    slope: np.ndarray | float = 0.0
+    microhardness: np.ndarray | float = 0.0
 
     @property
     def overlap(self) -> np.ndarray:

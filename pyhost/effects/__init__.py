@@ -53,7 +53,8 @@ REGISTRY = (
     ("conduction", "conduction", "conduction:LastingConduction"),
     ("case_commands", "fluid_solver", "case_commands:CaseCommands"),   # after the DEM's steps, before the fluid's exchange
     ("fluid", "fluid_solver", "fluid:FluidExchange"),
-    ("frames", None, "frames:Frames"),                                 # last: every other effect's columns
+    ("frames", None, "frames:Frames"),                                 # every other effect's columns
+    ("probes", None, "probes:Probes"),                                 # (when the scene names probes)
 )
 
 SUMMARY_ORDER = ("collisions", "balance", "conduction", "case_commands", "fluid")

@@ -21,7 +21,18 @@ restart, or without approach speed), or any contact when the scene has no collis
 conducts for the whole interval in which it is found at its end (a contact that begins
 within an interval is counted from the interval's start: at most ``every`` steps too early).
 The gas path conducts during collisions too (the collision models are the solid contact's).
-Walls do not conduct through this effect.
+
+Walls at a fixed temperature (``HostWall.temperature``; primitive planes and cylinders, a box
+scene's faces) conduct into the particles that touch them by the same models, the wall a sphere
+of ``WALL_RADIUS`` particle radii (R* within 0.1 % of the particle's radius, the plane's limit)
+of the wall's material, and the pair's exact relaxation with the wall's capacity infinite. Their
+heat is the balance's ``heat_from_walls`` (as a collision's with a wall) and summary.json's
+``heat_conducted_wall``. A wall contact conducts over every interval it is found in, its
+collision's t_coll included (a collision with a heated wall counts its heat twice during its
+t_coll, about 1e-5 s). Gap models with a reach beyond contact (``rong_horio``, whose lens is
+around the larger body: the wall) are refused with heated walls; ``lethe``'s macrogap is a
+contact's and goes to walls. ``network`` gives the conductances [W/K] the frozen stage
+(``pyhost.frozen``) integrates.
 """
 from __future__ import annotations
 
@@ -32,16 +43,24 @@ from plugins.dem.hertz import effective_modulus
 from pyhost.collisions import contact_keys
 from pyhost.effects import Effect
 from pyhost.engines.liggghts.script import ScriptError
+from pyhost.walls import primitive_overlap
+
+
+WALL_RADIUS = 1e3
+"""A wall's radius in the conduction models, in radii of the particle it touches [-]."""
 
 
 class LastingConduction(Effect):
     """``owned``: contact key -> end [s] of its last collision's model time (contacts whose
-    collision heat still stands for their time)."""
+    collision heat still stands for their time); ``walls``: the HostWalls at a temperature and
+    their geometry (``pyhost.walls`` primitives)."""
 
-    TOTALS = dict(heat_conducted_contact=0.0, heat_conducted_gap=0.0)
+    TOTALS = dict(heat_conducted_contact=0.0, heat_conducted_gap=0.0, heat_conducted_wall=0.0,
+                  frozen_stage=None)     # the frozen stage's figures (pyhost.frozen), when a scene has one
 
     def __init__(self, loop):
         super().__init__(loop)
+        self.walls = []                      # (HostWall, primitive) of the walls at a temperature (at_run)
         # scipy's tree only where a scene conducts: every other run is spared its import
         from scipy.spatial import cKDTree
 
@@ -62,6 +81,14 @@ class LastingConduction(Effect):
         softened = [m.dem for m in mats]      # the DEM's contact of each material (None: in no pair)
         self.E_dem = np.array([[effective_modulus(a.youngs_modulus, a.poisson_ratio, b.youngs_modulus, b.poisson_ratio)
                                 if a and b else np.nan for b in softened] for a in softened])
+        self.sigma = np.array([getattr(m, "roughness", 0.0) for m in mats])
+        self.slope = np.array([getattr(m, "surface_slope", 0.0) for m in mats])
+        self.hardness = np.array([getattr(m, "microhardness", 0.0) for m in mats])
+        if fx.contact_conduction == "lethe_rough":
+            for m, name in zip(mats, scene.materials):
+                if not (m.roughness > 0 and m.surface_slope > 0 and m.microhardness > 0):
+                    raise ScriptError(f"{scene.path}: materials.{name}: contact_conduction = \"lethe_rough\" needs "
+                                      "its roughness, surface_slope and microhardness (> 0)")
         self.t_last = loop.t
         self.owned = {}
         self.every = dict(conduct=c.every)
@@ -73,6 +100,29 @@ class LastingConduction(Effect):
     def end_run(self) -> None:
         """The run's steps since the last update."""
         self.conduct()
+
+    def at_run(self, walls) -> None:
+        """At each of a script's runs: the walls as they are now."""
+        self.update_walls(walls)
+
+    def update_walls(self, walls) -> None:
+        """The walls at a temperature that conduct, with their geometry from the script (a box
+        scene's generated one included); ScriptError for one the host cannot place."""
+        info = self.loop.dem.info
+        self.walls = []
+        for w in walls:
+            if not np.isfinite(w.temperature) or w.material < 0:
+                continue
+            wall = info.walls.get(w.fix)
+            if wall is None or wall.primitive is None or any(v is None for v in wall.primitive[1] or (None,)):
+                raise ScriptError(f"{self.loop.scene.path}: wall {w.fix!r} at {w.temperature:g} K: lasting "
+                                  "conduction from walls needs a primitive wall with numbers (a mesh wall, or one "
+                                  "placed by variables, is not placed by the host): give it no temperature")
+            if self.gap is not None and self.gap.reach(1.0, self.gas) > 0:
+                raise ScriptError(f"{self.loop.scene.path}: wall {w.fix!r} at {w.temperature:g} K: gap conduction "
+                                  f"{self.gap.name!r} reaches beyond contact around the larger body, which a wall "
+                                  "is: use gap_conduction = \"lethe\" with heated walls, or give the wall no temperature")
+            self.walls.append((w, wall.primitive))
 
     def collided(self, cols: dict) -> None:
         """Collisions just logged (``CollisionHeat.conclude``): their pair contacts belong to
@@ -105,9 +155,58 @@ class LastingConduction(Effect):
         near = dist < atoms.radius[i] + atoms.radius[j] + reach
         return i[near], j[near], dist[near]
 
+    def network(self, atoms):
+        """The conducting links of the particles ``atoms`` now: (i, j, H_contact, H_gap) of the
+        particle pairs (local indices, conductances [W/K]) and (p, T_w, H_contact, H_gap) of the
+        particles touching a wall at a temperature (T_w [K]); links with H = 0 left out."""
+        loop = self.loop
+        r_max = float(atoms.radius.max(initial=0.0))
+        reach = self.gap.reach(r_max, self.gas) if self.gap is not None else 0.0
+        i, j, dist = self.neighbours(atoms, reach)
+        zero = np.zeros(0)
+        pairs = (i, j, zero, zero)
+        if len(i):
+            mi, mj = loop.materials_of(atoms.type[i]), loop.materials_of(atoms.type[j])
+            pair = Pair(atoms.radius[i], atoms.radius[j], dist, self.k[mi], self.k[mj], self.E_dem[mi, mj],
+                        self.E_real[mi, mj], *self.surfaces(mi, mj))
+            pairs = self._links((i, j), pair)
+        p, T_w, Hc, Hg = [np.zeros(0, int)], [zero], [zero], [zero]
+        if self.walls and len(atoms.id):
+            mat = loop.materials_of(atoms.type)
+            for w, primitive in self.walls:
+                delta, _ = primitive_overlap(atoms.x, atoms.radius, primitive)
+                at = np.flatnonzero(delta > 0)
+                r = atoms.radius[at]
+                R = WALL_RADIUS * r
+                m = mat[at]
+                pair = Pair(r, R, r + R - delta[at], self.k[m], self.k[w.material], self.E_dem[m, w.material],
+                            self.E_real[m, w.material], *self.surfaces(m, w.material))
+                at, hc, hg = self._links((at,), pair)
+                p.append(at)
+                T_w.append(np.full(len(at), w.temperature))
+                Hc.append(hc)
+                Hg.append(hg)
+        return pairs, (np.concatenate(p), np.concatenate(T_w), np.concatenate(Hc), np.concatenate(Hg))
+
+    def surfaces(self, mi, mj):
+        """Equivalent roughness [m], slope [-] and effective microhardness [Pa] of the pairs of
+        materials mi, mj, as Lethe combines them (``plugins.conduction.Pair``)."""
+        Hi, Hj = self.hardness[mi], self.hardness[mj]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            H = np.where(Hi + Hj > 0, 2.0 * Hi * Hj / (Hi + Hj), 0.0)
+        return np.hypot(self.sigma[mi], self.sigma[mj]), np.hypot(self.slope[mi], self.slope[mj]), H
+
+    def _links(self, index, pair):
+        """(index arrays, H_contact, H_gap) [W/K] of the links of ``pair``, those with H = 0 dropped."""
+        n = len(pair.distance)
+        Hc = self.contact.conductance(pair) if self.contact is not None else np.zeros(n)
+        Hg = self.gap.conductance(pair, self.gas) if self.gap is not None else np.zeros(n)
+        on = (Hc + Hg) > 0
+        return (*(a[on] for a in index), Hc[on], Hg[on])
+
     def conduct(self) -> None:
         """The heat of the interval since the last update moved between the pairs now within
-        reach (the module doc)."""
+        reach, and from the walls at a temperature (the module doc)."""
         loop = self.loop
         t0, t1 = self.t_last, loop.t
         self.t_last = t1
@@ -115,26 +214,27 @@ class LastingConduction(Effect):
             return
         atoms = loop.dem.atoms(True)
         loop.track_particles(atoms)
-        r_max = float(atoms.radius.max(initial=0.0))
-        reach = self.gap.reach(r_max, self.gas) if self.gap is not None else 0.0
-        i, j, dist = self.neighbours(atoms, reach)
-        if len(i):
-            mi, mj = loop.materials_of(atoms.type[i]), loop.materials_of(atoms.type[j])
-            pair = Pair(atoms.radius[i], atoms.radius[j], dist, self.k[mi], self.k[mj], self.E_dem[mi, mj],
-                        self.E_real[mi, mj])
-            G_contact = (self.contact.conductance(pair) * self.contact_time(atoms.id[i], atoms.id[j], t0, t1)
-                         if self.contact is not None else np.zeros(len(i)))
-            G_gap = self.gap.conductance(pair, self.gas) * (t1 - t0) if self.gap is not None else np.zeros(len(i))
-            G = G_contact + G_gap
-            on = G > 0
-            i, j, G, G_contact = i[on], j[on], G[on], G_contact[on]
-            C = loop.C
-            q = exchange(atoms.T, C, i, j, G)
+        (i, j, Hc, Hg), (p, T_w, Wc, Wg) = self.network(atoms)
+        if len(i) or len(p):
+            G_contact = Hc * self.contact_time(atoms.id[i], atoms.id[j], t0, t1) if len(i) else Hc
+            G = np.r_[G_contact + Hg * (t1 - t0), (Wc + Wg) * (t1 - t0)]
             n = len(atoms.T)
-            atoms.T[:] += (np.bincount(i, q, n) - np.bincount(j, q, n)) / C
-            share = G_contact / G
-            self.loop.totals["heat_conducted_contact"] += float(np.abs(q * share).sum())
-            self.loop.totals["heat_conducted_gap"] += float(np.abs(q * (1.0 - share)).sum())
+            # the walls: nodes n, n+1, ... of infinite capacity at their temperature
+            T = np.r_[atoms.T, T_w]
+            C = np.r_[loop.C, np.full(len(p), np.inf)]
+            a, b = np.r_[i, p].astype(int), np.r_[j, n + np.arange(len(p))].astype(int)
+            q = exchange(T, C, a, b, G)
+            atoms.T[:] += np.bincount(a, q, n + len(p))[:n] / loop.C - np.bincount(b, q, n + len(p))[:n] / loop.C
+            qp, qw = q[:len(i)], q[len(i):]
+            share = np.divide(G_contact, G[:len(i)], out=np.zeros(len(i)), where=G[:len(i)] > 0)
+            self.loop.totals["heat_conducted_contact"] += float(np.abs(qp * share).sum())
+            self.loop.totals["heat_conducted_gap"] += float(np.abs(qp * (1.0 - share)).sum())
+            self.loop.totals["heat_conducted_wall"] += float(qw.sum())
+            self.loop.totals["heat_from_walls"] += float(qw.sum())
+            # the balance sees the temperatures as moved here: the next run's resync must not count
+            # this interval's wall heat again as set by the script (the end of a run conducts after
+            # the balance's last look)
+            loop.track_particles(atoms)
         self.owned = {k: end for k, end in self.owned.items() if end > t1}
 
     def contact_time(self, ids_i, ids_j, t0: float, t1: float) -> np.ndarray:

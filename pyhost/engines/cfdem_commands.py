@@ -212,7 +212,7 @@ def write_times(control: dict, start: float, t0: float, t1: float) -> int:
 
 
 def couples_to_cfd(commands) -> bool:
-    """Whether a LIGGGHTS script (its commands, ``pyhost.script.Command``) is a CFDEM one: it
+    """Whether a LIGGGHTS script (its commands, ``pyhost.engines.liggghts.script.Command``) is a CFDEM one: it
     defines ``fix ID GROUP couple/cfd``. CFDEM runs such a script whole, its last run too
     (often ``run 1``), then its coupling drives the DEM."""
     return any(c.name == "fix" and c.words[3:4] == ["couple/cfd"] for c in commands)

@@ -23,8 +23,8 @@ def pair(distance, E_dem=1e8, E_real=1e8, r_i=R1, r_j=R2, k_i=K1, k_j=K2):
 
 
 def test_registries_hold_the_models_and_refuse_others_with_the_list():
-    assert list(CONTACT) == ["lethe", "mfix", "morris"] and list(GAP) == ["lethe", "rong_horio"]
-    with pytest.raises(ValueError, match="unknown contact conduction model 'zhou'; choices: lethe, mfix, morris"):
+    assert list(CONTACT) == ["lethe", "lethe_rough", "mfix", "morris"] and list(GAP) == ["lethe", "rong_horio"]
+    with pytest.raises(ValueError, match="unknown contact conduction model 'zhou'; choices: lethe, lethe_rough, mfix, morris"):
         CONTACT.lookup("zhou")
     with pytest.raises(ValueError, match="unknown gap conduction model 'bob'; choices: lethe, rong_horio"):
         GAP.lookup("bob")
@@ -176,3 +176,28 @@ def test_rong_horio_small_sphere_inside_the_lens_conducts_as_mfix_does():
     h1 = half_lens(np.sqrt(1.0 + (small - o1) ** 2), s1, o1, small) * small * GAS.conductivity
     h2 = half_lens(np.sqrt(1.0 + (big - (delta - o1)) ** 2), s - s1, delta - o1, big) * big * GAS.conductivity
     assert H == pytest.approx(h1 * h2 / (h1 + h2), rel=1e-12)
+
+
+def test_lethe_rough_is_lethe_in_series_with_the_microcontact():
+    """Smooth surfaces give ``lethe``; rough ones its macrocontact resistance plus Van Lew's
+    microcontact resistance, here written out for one steel pair of Beaulieu's bed (Lethe's
+    published values: sigma 19 nm and m 0.056 per surface, H_c 3 GPa, E 200 GPa real, 50 MPa
+    softened, nu 0.29), and R_mc falls as p_max^-0.96 (the overlap's p_max^2 ~ delta)."""
+    E_dem = 50e6 / (2 * (1 - 0.29**2))
+    E_real = 200e9 / (2 * (1 - 0.29**2))
+    r, delta = 3.2e-3, 1e-5
+    smooth = Pair(r, r, 2 * r - delta, 42.0, 42.0, E_dem, E_real)
+    rough = smooth._replace(roughness=np.hypot(19e-9, 19e-9), slope=np.hypot(0.056, 0.056), microhardness=3e9)
+    assert CONTACT["lethe_rough"].conductance(smooth) == CONTACT["lethe"].conductance(smooth)
+    a = np.sqrt(r / 2 * delta) * (E_dem / E_real) ** 0.2
+    p = 2 * E_real * delta * (E_dem / E_real) ** (2 / 3) / (np.pi * a)
+    R_mc = 1.184 / (np.pi * 42.0 * a * a) * (np.hypot(19e-9, 19e-9) / np.hypot(0.056, 0.056)) * (3e9 / p) ** 0.96
+    assert 0 < 2 * p / 3e9 < 2                              # the correlation's range
+    H = CONTACT["lethe_rough"].conductance(rough)
+    assert H == pytest.approx(1 / (0.5 / (a * 42.0) + R_mc), rel=1e-12)
+    assert H < CONTACT["lethe"].conductance(smooth)
+    # p_max ~ delta^(1/2), a^2 ~ delta: R_mc ~ delta^-1 * delta^-0.48
+    from plugins.conduction.contact.lethe_rough import microcontact_resistance
+    ratio = microcontact_resistance(rough._replace(distance=2 * r - 4 * delta)) / microcontact_resistance(rough)
+    assert ratio == pytest.approx(4.0 ** (-1 - 0.48), rel=1e-12)
+    assert CONTACT["lethe_rough"].conductance(rough._replace(distance=2 * r + 1e-9)) == 0

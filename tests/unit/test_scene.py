@@ -85,7 +85,7 @@ def test_dry_isothermal_scene_builds_nothing_extra(tmp_path):
     ("[domain]", "[fluid]\nheat_capacity = -5.0\n\n[domain]", "fluid.heat_capacity: must be > 0"),
     ("dem_step = 1e-6", "dem_step = nan", "time.dem_step: must be finite"),
     ('contact_heat = "A"', 'contact_heat = "A"\ncontact_conduction = "zhou"',
-     "effects.contact_conduction: must be one of none, lethe, mfix, morris, got 'zhou'"),
+     "effects.contact_conduction: must be one of none, lethe, lethe_rough, mfix, morris, got 'zhou'"),
     ('contact_heat = "A"', 'contact_heat = "A"\ngap_conduction = "bob"',
      "effects.gap_conduction: must be one of none, lethe, rong_horio, got 'bob'"),
     ('contact_heat = "A"', 'contact_heat = "A"\ncontact_conduction = "mfix"\nenduring_conduction = true',
@@ -196,4 +196,4 @@ def test_a_conduction_mistake_stops_the_run_with_exit_2(tmp_path):
     r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(tmp_path), "--out", str(tmp_path / "out")],
                        capture_output=True, text=True)
     assert r.returncode == 2
-    assert str(path) in r.stderr and "effects.contact_conduction: must be one of none, lethe, mfix, morris" in r.stderr
+    assert str(path) in r.stderr and "effects.contact_conduction: must be one of none, lethe, lethe_rough, mfix, morris" in r.stderr
