@@ -65,3 +65,15 @@ def test_full_case_within_1_5_K_of_the_experiment_after_900_s(full):
     result = compare(out)
     print(result)
     assert all(worst <= 1.5 for worst, mean, n in result.values())
+
+
+@pytest.mark.validation
+def test_full_case_holds_what_it_measured(full):
+    """What the published values give now (README.md), so that a change that moves the bed away
+    from the experiment fails: 60 and 73 mm within the goal's 1.5 K after 900 s, 40 mm within
+    3.0 K (measured 2.48 K; the goal itself is the expected failure above)."""
+    out, summary, seconds = full
+    result = compare(out)
+    print(result)
+    assert result["T_60mm"][0] <= 1.5 and result["T_73mm"][0] <= 1.5
+    assert result["T_40mm"][0] <= 3.0
