@@ -151,6 +151,28 @@ def pytest_collection_modifyitems(config, items):
     items[:] = [item for item in items if item not in last] + last
 
 
+def once(tmp_path_factory, name: str, make):
+    """The folder ``make(folder)`` fills, made once in a test session whichever of pytest-xdist's
+    workers asks first (the others wait for it and take it): a module's fixture would be built
+    by each worker that runs one of its tests (the 4-minute packed bed twice). A ``make`` that
+    fails leaves no folder: the next asker tries again (and fails the same way)."""
+    import fcntl
+    import os
+    import shutil
+
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base    # (the workers' common folder)
+    folder = root / f"once-{name}"
+    with open(root / f"once-{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (folder / ".done").exists():
+            shutil.rmtree(folder, ignore_errors=True)
+            folder.mkdir()
+            make(folder)
+            (folder / ".done").write_text("")
+    return folder
+
+
 # ``python -c STOPPER STEP SIGNAL run CASE ...``: pyhost's CLI, whose DEM sends itself SIGNAL (a
 # name: SIGTERM, SIGKILL, ...) after the first chunk that reaches STEP (a batch system's stop).
 STOPPER = """

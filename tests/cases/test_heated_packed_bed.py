@@ -14,6 +14,7 @@ ROOT = Path(__file__).resolve().parents[2]
 CASE = ROOT / "cases" / "heated-packed-bed"
 sys.path.insert(0, str(CASE))
 from compare import compare  # noqa: E402
+from conftest import once  # noqa: E402
 
 pytestmark = pytest.mark.engines
 
@@ -42,9 +43,13 @@ def test_smoke_run_writes_the_probes_and_closes_the_balance(tmp_path):
 
 @pytest.fixture(scope="module")
 def full(tmp_path_factory):
-    out = tmp_path_factory.mktemp("packed") / "out"
-    summary, seconds = run(out)
-    return out, summary, seconds
+    def make(folder):
+        summary, seconds = run(folder / "out")
+        (folder / "seconds").write_text(repr(seconds))
+
+    folder = once(tmp_path_factory, "heated-packed-bed", make)
+    out = folder / "out"
+    return out, json.loads((out / "summary.json").read_text()), float((folder / "seconds").read_text())
 
 
 @pytest.mark.validation

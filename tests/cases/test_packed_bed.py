@@ -10,6 +10,7 @@ import pytest
 
 from pyhost.fluidization import measure
 from pyhost.scene import load_scene
+from conftest import once
 
 pytestmark = [pytest.mark.engines, pytest.mark.long]   # a validation of the fluid: about 20 s
 CASE = Path(__file__).resolve().parents[2] / "cases" / "packed-bed-ergun"
@@ -17,10 +18,12 @@ CASE = Path(__file__).resolve().parents[2] / "cases" / "packed-bed-ergun"
 
 @pytest.fixture(scope="module")
 def curve(tmp_path_factory):
-    out = tmp_path_factory.mktemp("packed-bed")
-    r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(CASE), "--out", str(out)],
-                       capture_output=True, text=True)
-    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    def make(folder):
+        r = subprocess.run([sys.executable, "-m", "pyhost", "run", str(CASE), "--out", str(folder / "out")],
+                           capture_output=True, text=True)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+
+    out = once(tmp_path_factory, "packed-bed-ergun", make) / "out"
     return out, measure(out)
 
 
