@@ -81,9 +81,9 @@ class LastingConduction(Effect):
         softened = [m.dem for m in mats]      # the DEM's contact of each material (None: in no pair)
         self.E_dem = np.array([[effective_modulus(a.youngs_modulus, a.poisson_ratio, b.youngs_modulus, b.poisson_ratio)
                                 if a and b else np.nan for b in softened] for a in softened])
-        self.sigma = np.array([getattr(m, "roughness", 0.0) for m in mats])
-        self.slope = np.array([getattr(m, "surface_slope", 0.0) for m in mats])
-        self.hardness = np.array([getattr(m, "microhardness", 0.0) for m in mats])
+        self.sigma = np.array([m.roughness for m in mats])
+        self.slope = np.array([m.surface_slope for m in mats])
+        self.hardness = np.array([m.microhardness for m in mats])
         if fx.contact_conduction == "lethe_rough":
             for m, name in zip(mats, scene.materials):
                 if not (m.roughness > 0 and m.surface_slope > 0 and m.microhardness > 0):
@@ -102,12 +102,9 @@ class LastingConduction(Effect):
         self.conduct()
 
     def at_run(self, walls) -> None:
-        """At each of a script's runs: the walls as they are now."""
-        self.update_walls(walls)
-
-    def update_walls(self, walls) -> None:
-        """The walls at a temperature that conduct, with their geometry from the script (a box
-        scene's generated one included); ScriptError for one the host cannot place."""
+        """At each of a script's runs: the walls at a temperature that conduct, with their
+        geometry from the script (a box scene's generated one included); ScriptError for one the
+        host cannot place."""
         info = self.loop.dem.info
         self.walls = []
         for w in walls:
