@@ -27,7 +27,7 @@ from pyhost.collisions import wall_code
 from pyhost.engines.atoms import Atoms, local_view
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
-from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
+from pyhost.engines.ranks import (ENGINE, gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_snapshot, local_values, put_by_id, set_random_states, write_local)
 from pyhost.engines.liggghts.script import Command, ScriptError, ScriptInfo, output_files
 
@@ -408,6 +408,7 @@ class Dem:
         by name) on every rank, on its own atoms (``local_view``: LIGGGHTS' memory, T writable)
         and contact events; the ranks' results in rank order (serially: the one result, in a
         list, comm None). What the host changed in gathered atoms goes back first."""
+        ENGINE[0] = self.lmp            # (ranks.ENGINE: for a func that needs more than the atoms)
         if self.link is None:
             return [func(local_view(self.lmp), self.events, None, *args)]
         self._order("each_rank", func, args)

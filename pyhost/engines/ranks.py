@@ -24,6 +24,9 @@ import numpy as np
 from pyhost.engines.atoms import local_view
 
 ROOT = 0
+ENGINE = [None]
+"""This process's LIGGGHTS while a ``Dem.each_rank`` function runs on it (rank 0's and each
+follower's): for a function that needs more than its atoms (the fluid's force fix)."""
 
 
 def world():
@@ -277,6 +280,7 @@ class Follower:
 
     def do_each_rank(self, func, args) -> None:
         """``Dem.each_rank``: ``func`` on this rank's atoms and events, its result to rank 0."""
+        ENGINE[0] = self.lmp
         self.comm.gather(func(local_view(self.lmp), self.events, self.comm, *args), root=ROOT)
 
     def do_write(self, force_fix) -> None:
