@@ -181,7 +181,7 @@ class FluidExchange(Effect):
         if any("outside" in p for p in parts):      # a failed simulation (exit 3), not bad input
             ids, x, v = (np.concatenate([p["outside"][k] for p in parts]) for k in range(3))
             raise left_the_mesh(ids, x, v, loop.t)
-        if any("unresolved" in p for p in parts):
+        if any(len(p["unresolved"][0]) for p in parts):     # (their forces are set: the run stops here)
             ids, k, mass, d = (np.concatenate([p["unresolved"][c] for p in parts]) for c in range(4))
             raise drag_unresolved(ids, k, mass, d, interval, loop.dem.dt, loop.t)
         sums = parts[0]

@@ -410,9 +410,10 @@ class Dem:
         list, comm None). What the host changed in gathered atoms goes back first."""
         ENGINE[0] = self.lmp            # (ranks.ENGINE: for a func that needs more than the atoms)
         if self.link is None:
-            return [func(local_view(self.lmp), self.events, None, *args)]
-        self._order("each_rank", func, args)
-        mine = func(local_view(self.lmp), self.events.local, self.link.comm, *args)
+            return [func(local_view(self.lmp, self.heat), self.events, None, *args)]
+        self._order("each_rank", func, args, self.heat)    # (T None without heat: LIGGGHTS has no Temp then)
+        mine = func(local_view(self.lmp, self.heat), None if self.events is None else self.events.local,
+                    self.link.comm, *args)
         self._pending = None            # func may change the atoms' Temp: a gathered copy is out of date
         return self.link.gather(mine)
 

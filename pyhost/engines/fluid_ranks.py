@@ -18,9 +18,10 @@ own atoms instead, with O(cells) on rank 0:
    drag (the same drag law, ``openfoam.fluid_fraction`` and ``openfoam.fluid_force`` as the
    gather path), writes their force into its own LIGGGHTS (``fix collheat_fluid``) and its
    per-cell sums of K and K v go to rank 0 (Reduce), which hands them to the next ADVANCE.
-3. A particle outside the mesh, or one whose drag the coupling interval does not resolve, stops
-   every rank before any force is set; the ranks send rank 0 those particles only, and the
-   failure names the same particle as the gather path (the first in rank order).
+3. A particle outside the mesh stops every rank before any force is set; one whose drag the
+   coupling interval does not resolve stops the run after (its forces set, never used). The
+   ranks send rank 0 those particles only, and the failure names the same particle as the
+   gather path (the first in rank order), with the same count.
 
 Cells are matched as OpenFOAM's LOCATE matches them (a point on a face belongs to both cells
 there, and either may be taken: the solver's own choice depends on its hints). The per-cell sums
@@ -145,10 +146,11 @@ def wrapped(x, lo, hi, periodic) -> np.ndarray:
 def exchange_on_rank(atoms, events, comm, job: Job) -> dict:
     """``Dem.each_rank``'s part of one exchange on this rank's atoms (module doc): their forces
     into this rank's LIGGGHTS; returns on rank 0 the summed per-cell particle volume ``solid``
-    [m^3], K ``ksum`` [kg/s] and K v ``kv`` [kg m/s^2] in the grid's order. If a particle of
-    any rank is outside the mesh (``outside``: ids, positions, velocities of this rank's) or
-    has its drag unresolved (``unresolved``: ids, K, mass, d of this rank's with K interval /
-    m > 1), no rank sets a force and each returns only those."""
+    [m^3], K ``ksum`` [kg/s] and K v ``kv`` [kg m/s^2] in the grid's order; on every rank
+    ``unresolved``, the ids, K [kg/s], mass [kg] and d [m] of its particles whose drag the
+    interval does not resolve (K interval / m > 1: the run fails, ``drag_unresolved``). If a
+    particle of any rank is outside the mesh, no rank sets a force and each returns only its
+    own outside (``outside``: ids, positions [m], velocities [m/s])."""
     grid = BoxGrid(job.faces, np.zeros(0, np.int64))
     ncells = len(job.volumes)
     x = wrapped(atoms.x, job.lo, job.hi, job.periodic)
@@ -164,16 +166,14 @@ def exchange_on_rank(atoms, events, comm, job: Job) -> dict:
     u, gradp = job.u[cell], job.gradp[cell]
     slip = u - atoms.v
     k = drag_laws.LAWS.lookup(job.drag)(alpha[cell], np.linalg.norm(slip, axis=1), d, job.rho, job.nu)
-    ratio = k * job.interval / atoms.mass
-    over = ratio > 1.0
-    if _largest(comm, float(over.any())):
-        return dict(unresolved=(atoms.id[over].copy(), k[over], atoms.mass[over].copy(), d[over]))
+    over = k * job.interval / atoms.mass > 1.0
     if len(k):
         ENGINE[0].external_force(FLUID_FIX)[:] = fluid_force(k, slip, vp, job.rho, gradp)
     sums = np.stack([np.bincount(cell, k, ncells)] + [np.bincount(cell, k * atoms.v[:, i], ncells) for i in range(3)],
                     axis=1)
     sums = _summed(comm, sums)
-    return dict(solid=solid, ksum=sums[:, 0], kv=sums[:, 1:]) if sums is not None else {}
+    mine = dict(unresolved=(atoms.id[over].copy(), k[over], atoms.mass[over].copy(), d[over]))
+    return mine if sums is None else dict(mine, solid=solid, ksum=sums[:, 0], kv=sums[:, 1:])
 
 
 def _everywhere(comm, values: np.ndarray) -> tuple[np.ndarray, float]:
@@ -186,14 +186,6 @@ def _everywhere(comm, values: np.ndarray) -> tuple[np.ndarray, float]:
         comm.Bcast(total, root=0)
         values = total
     return values[:-1], float(values[-1])
-
-
-def _largest(comm, value: float) -> float:
-    """The largest of the ranks' ``value``, on every rank."""
-    if comm is None:
-        return value
-    from mpi4py import MPI
-    return comm.allreduce(value, op=MPI.MAX)
 
 
 def _summed(comm, values: np.ndarray) -> np.ndarray | None:

@@ -278,10 +278,11 @@ class Follower:
     def do_snapshot(self) -> None:
         gather_arrays(self.comm, self.snap)
 
-    def do_each_rank(self, func, args) -> None:
+    def do_each_rank(self, func, args, temperature=True) -> None:
         """``Dem.each_rank``: ``func`` on this rank's atoms and events, its result to rank 0."""
         ENGINE[0] = self.lmp
-        self.comm.gather(func(local_view(self.lmp), self.events, self.comm, *args), root=ROOT)
+        self.comm.gather(func(local_view(self.lmp, temperature), getattr(self, "events", None), self.comm, *args),
+                         root=ROOT)
 
     def do_write(self, force_fix) -> None:
         write_local(self.lmp, *self.comm.scatter(None, root=ROOT), force_fix=force_fix, rows=getattr(self, "rows", None))
