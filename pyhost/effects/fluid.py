@@ -11,8 +11,9 @@ import os
 import numpy as np
 
 from plugins import convection
+from plugins.drag import fluid_fraction
 from pyhost.effects import Effect, by_id
-from pyhost.engines.openfoam import OutsideMesh, fluid_fraction
+from pyhost.engines.openfoam import OutsideMesh
 from pyhost.failures import drag_unresolved, left_the_mesh
 from pyhost.output import VtkSeries
 
@@ -169,6 +170,7 @@ class FluidExchange(Effect):
         rank 0 sends every rank the fluid of each cell and gets back each cell's sums over the
         particles, O(cells); a particle outside the mesh or with its drag unresolved fails the
         run as in ``couple``, named as there."""
+        from pyhost.engines.dem import FLUID_FIX
         from pyhost.engines.fluid_ranks import Job, exchange_on_rank
 
         loop, fluid, grid = self.loop, self.fluid, self.grid
@@ -176,7 +178,7 @@ class FluidExchange(Effect):
         interval = loop.every["couple"] * loop.dem.dt
         u, gradp = fluid.cell_fluid()
         job = Job(grid.faces, grid.to_grid(u), grid.to_grid(gradp), grid.to_grid(fluid.cell_volumes), lo, hi,
-                  periodic, fluid.rho, fluid.nu, fluid.drag, fluid.alpha_min, interval)
+                  periodic, fluid.rho, fluid.nu, fluid.drag, fluid.alpha_min, interval, FLUID_FIX)
         parts = loop.dem.each_rank(exchange_on_rank, job)
         if any("outside" in p for p in parts):      # a failed simulation (exit 3), not bad input
             ids, x, v = (np.concatenate([p["outside"][k] for p in parts]) for k in range(3))
@@ -187,7 +189,6 @@ class FluidExchange(Effect):
         sums = parts[0]
         fluid.take_particles(fluid_fraction(grid.to_solver(sums["solid"]), fluid.cell_volumes, fluid.alpha_min),
                              grid.to_solver(sums["ksum"]), grid.to_solver(sums["kv"]))
-        fluid.cell, fluid.slip = np.zeros(0, np.int64), np.zeros(0)      # (the particles' own are on their ranks)
         fluid.advance(interval, fluid.substeps(interval), wait=not self.overlap)
         self.force = None               # on the ranks: gathered only for a checkpoint (``state``)
 
@@ -274,8 +275,9 @@ class FluidExchange(Effect):
 
     def state(self) -> tuple[dict, dict]:
         if self.force is None:          # the exchange on the ranks: their forces now, as set there
+            from pyhost.engines.dem import FLUID_FIX
             from pyhost.engines.fluid_ranks import force_on_rank
-            parts = self.loop.dem.each_rank(force_on_rank)
+            parts = self.loop.dem.each_rank(force_on_rank, FLUID_FIX)
             self.force = tuple(np.concatenate([p[k] for p in parts]) for k in range(2))
         return (dict(gas_energy0=self.gas_energy0, logs=dict(fluid=self.frames.frames if self.frames else None)),
                 dict(fluid_ids=self.force[0], fluid_force=self.force[1]))

@@ -15,7 +15,7 @@ own atoms instead, with O(cells) on rank 0:
    ``Dem.each_rank`` call (``exchange_on_rank``). Each rank finds its particles' cells
    (``np.searchsorted``), sums their volume per cell; the ranks add their sums (MPI Reduce and
    Bcast, so every rank has the same fluid fraction); each rank then computes its particles'
-   drag (the same drag law, ``openfoam.fluid_fraction`` and ``openfoam.fluid_force`` as the
+   drag (the same drag law, ``plugins.drag.fluid_fraction`` and ``fluid_force`` as the
    gather path), writes their force into its own LIGGGHTS (``fix collheat_fluid``) and its
    per-cell sums of K and K v go to rank 0 (Reduce), which hands them to the next ADVANCE.
 3. A particle outside the mesh stops every rank before any force is set; one whose drag the
@@ -35,8 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from plugins import drag as drag_laws
-from pyhost.engines.dem import FLUID_FIX
-from pyhost.engines.openfoam import fluid_force, fluid_fraction
+from plugins.drag import fluid_force, fluid_fraction
 from pyhost.engines.ranks import ENGINE
 
 
@@ -122,7 +121,8 @@ class Job:
     velocity [m/s] and ``gradp`` the kinematic pressure gradient [m/s^2] (n, 3), ``volumes``
     [m^3]; the box (``lo``, ``hi`` [m], ``periodic``: the DEM wraps its atoms only at
     re-neighbouring), the gas (``rho`` [kg/m^3], ``nu`` [m^2/s]), the drag law's name,
-    ``alpha_min`` and the coupling ``interval`` [s]."""
+    ``alpha_min``, the coupling ``interval`` [s] and the LIGGGHTS ``fix`` the forces go to
+    (``dem.FLUID_FIX``)."""
 
     faces: tuple
     u: np.ndarray
@@ -136,6 +136,7 @@ class Job:
     drag: str
     alpha_min: float
     interval: float
+    fix: str
 
 
 def wrapped(x, lo, hi, periodic) -> np.ndarray:
@@ -158,7 +159,7 @@ def exchange_on_rank(atoms, events, comm, job: Job) -> dict:
     lost = cell < 0
     d = 2.0 * atoms.radius
     vp = np.pi * d**3 / 6.0
-    solid = np.bincount(cell[~lost], vp[~lost], ncells) if not lost.any() else np.zeros(ncells)
+    solid = np.zeros(ncells) if lost.any() else np.bincount(cell, vp, ncells)
     solid, n_lost = _everywhere(comm, np.r_[solid, float(lost.sum())])
     if n_lost:
         return dict(outside=(atoms.id[lost].copy(), x[lost], atoms.v[lost].copy()))
@@ -168,7 +169,7 @@ def exchange_on_rank(atoms, events, comm, job: Job) -> dict:
     k = drag_laws.LAWS.lookup(job.drag)(alpha[cell], np.linalg.norm(slip, axis=1), d, job.rho, job.nu)
     over = k * job.interval / atoms.mass > 1.0
     if len(k):
-        ENGINE[0].external_force(FLUID_FIX)[:] = fluid_force(k, slip, vp, job.rho, gradp)
+        ENGINE[0].external_force(job.fix)[:] = fluid_force(k, slip, vp, job.rho, gradp)
     sums = np.stack([np.bincount(cell, k, ncells)] + [np.bincount(cell, k * atoms.v[:, i], ncells) for i in range(3)],
                     axis=1)
     sums = _summed(comm, sums)
@@ -204,7 +205,8 @@ def height_on_rank(atoms, events, comm, up, floor) -> tuple[float, int]:
     return float(np.sum(atoms.x @ up - floor)), len(atoms.x)
 
 
-def force_on_rank(atoms, events, comm) -> tuple[np.ndarray, np.ndarray]:
-    """``Dem.each_rank``: this rank's atom ids and the fluid's force on them [N] (a checkpoint)."""
-    force = ENGINE[0].external_force(FLUID_FIX) if len(atoms.id) else np.zeros((0, 3))
+def force_on_rank(atoms, events, comm, fix: str) -> tuple[np.ndarray, np.ndarray]:
+    """``Dem.each_rank``: this rank's atom ids and the fluid's force on them [N] (LIGGGHTS' ``fix``
+    external's array: a checkpoint)."""
+    force = ENGINE[0].external_force(fix) if len(atoms.id) else np.zeros((0, 3))
     return atoms.id.copy(), np.array(force)

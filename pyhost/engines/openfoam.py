@@ -33,6 +33,7 @@ import numpy as np
 from foamlib import FoamFile
 
 from plugins import drag as drag_laws
+from plugins.drag import fluid_force, fluid_fraction
 from pyhost.engines.fluid_case import is_time_name, start_time
 
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
@@ -55,19 +56,6 @@ def _divided_points() -> np.ndarray:
 
 
 DIVIDED = _divided_points()
-
-
-def fluid_fraction(solid: np.ndarray, volumes: np.ndarray, alpha_min: float) -> np.ndarray:
-    """Each cell's fluid volume fraction (-): 1 less its particles' volume ``solid`` [m^3] over
-    its volume [m^3], floored at ``alpha_min``."""
-    return np.maximum(1.0 - solid / volumes, alpha_min)
-
-
-def fluid_force(k: np.ndarray, slip: np.ndarray, vp: np.ndarray, rho: float, gradp: np.ndarray) -> np.ndarray:
-    """The fluid's force on each particle [N] (n, 3): drag ``K (u - v)`` (``k`` [kg/s], ``slip``
-    u - v [m/s]) and the pressure gradient's ``-V_p rho grad(p/rho)`` (``vp`` [m^3], ``rho``
-    [kg/m^3], ``gradp`` the kinematic gradient [m/s^2])."""
-    return k[:, None] * slip - (vp * rho)[:, None] * gradp
 
 
 class FluidError(RuntimeError):

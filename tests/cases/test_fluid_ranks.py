@@ -46,7 +46,7 @@ if os.environ.get("CROSS_CHECK"):
         advance = f.advance
         def checked(*args, **kwargs):
             fields = f._alpha.copy(), f._ksl.copy(), f._us.copy()
-            parts = loop.dem.each_rank(force_on_rank)
+            parts = loop.dem.each_rank(force_on_rank, "collheat_fluid")
             ids, force = (np.concatenate([p[k] for p in parts]) for k in range(2))
             atoms = loop.dem.atoms(False)
             lo, hi, periodic = loop.dem.box()
