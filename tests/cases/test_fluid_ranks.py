@@ -168,3 +168,26 @@ def test_a_particle_outside_the_mesh_fails_the_run_naming_it_as_the_gather_path(
     assert len(lines[""]) == 1 and lines[""] == lines["0"]
     count = int(lines[""][0].split(" particle(s) are outside")[0].rsplit(" ", 1)[1])
     assert 500 < count < 3000, lines[""]
+
+
+def test_checkpoint_of_the_exchange_on_the_ranks_holds_the_forces_and_continues_as_gathered(tmp_path):
+    """The bed on two ranks with a checkpoint at its end (0.01 s): the fluid forces the
+    checkpoint keeps, gathered from the ranks' LIGGGHTS, are the gather path's (ids and forces,
+    bit for bit); continued for 2 ms more (--restart --extend), it gives the gathered run's
+    collisions.csv."""
+    case = bed(tmp_path, "checkpoint = 0.02\n")
+    forces = {}
+    for on in ("", "0"):
+        out = tmp_path / f"out{on}"
+        run(case, out, 2, dict(FLUID_ON_RANKS=on))
+        with np.load(out / "checkpoint" / "host.npz") as saved:
+            forces[on] = saved["fluid_ids"], saved["fluid_force"]
+        r = subprocess.run(["mpirun", "--oversubscribe", "-np", "2", sys.executable, "-c", DRIVER, "run", str(case),
+                            "--test", "--out", str(out), "--restart", "--extend", "0.002"], capture_output=True,
+                           text=True, env=dict(ENV, FLUID_ON_RANKS=on), timeout=600)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert len(forces[""][0]) == 3000 and np.abs(forces[""][1]).max() > 0
+    for k in range(2):
+        assert np.array_equal(forces[""][k], forces["0"][k])
+    a, b = ((tmp_path / f"out{on}" / "collisions.csv").read_bytes() for on in ("", "0"))
+    assert a == b and a.count(b"\n") > 100
