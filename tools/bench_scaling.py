@@ -68,7 +68,7 @@ class TimedFluid:
 
     def __getattr__(self, name):
         attr = getattr(self.fluid, name)
-        if name not in ("particle_forces", "advance", "fields", "temperature"):
+        if name not in ("particle_forces", "cell_fluid", "advance", "fields", "temperature"):
             return attr
 
         def timed(*args, **kwargs):

@@ -19,7 +19,24 @@ set II) and the host adds it separately.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from plugins.registry import Registry
 
 LAWS = Registry(__name__, __path__, "drag law")
 """{name: law}; ``LAWS.lookup(name)`` for a message naming the choices."""
+
+
+def fluid_fraction(solid, volumes, alpha_min: float):
+    """Each cell's fluid volume fraction (-): 1 less its particles' volume ``solid`` [m^3] over
+    the cell's volume [m^3], floored at ``alpha_min`` (the "centre" rule: a particle's whole
+    volume in the cell of its centre)."""
+    return np.maximum(1.0 - solid / volumes, alpha_min)
+
+
+def fluid_force(k, slip, vp, rho: float, gradp):
+    """The fluid's force on each particle [N] (n, 3) in model A (module doc): drag ``K (u - v)``
+    (``k`` [kg/s], ``slip`` u - v [m/s], (n, 3)) plus the pressure gradient's
+    ``-V_p rho grad(p/rho)`` (``vp`` [m^3], ``rho`` [kg/m^3], ``gradp`` the kinematic pressure
+    gradient [m/s^2], (n, 3))."""
+    return k[:, None] * slip - (vp * rho)[:, None] * gradp

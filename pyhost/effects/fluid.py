@@ -11,6 +11,7 @@ import os
 import numpy as np
 
 from plugins import convection
+from plugins.drag import fluid_fraction
 from pyhost.effects import Effect, by_id
 from pyhost.engines.openfoam import OutsideMesh
 from pyhost.failures import drag_unresolved, left_the_mesh
@@ -22,6 +23,12 @@ particles' and the gas's energy and what crossed the fluid's boundaries): the pr
 give 1e-12 and below; CFDEM's packedBedTemp, whose fvSolution solves T to its own tolerance,
 1.04e-7 (tools/corpus.py). A convected heat lost on one side shows as its share of that total
 (packedBedTemp: 540 J convected of 5,400 J, 0.1)."""
+
+ON_RANKS: bool | None = None
+"""Where the particles' side of each exchange is done (``pyhost.engines.fluid_ranks``): None,
+on each MPI rank under mpirun where the case allows it (``per_rank_grid``), else on rank 0
+with every atom gathered; False, always gathered; True, where the case allows it, serially too
+(a test's switch: the same numbers as the gather path then, bit for bit)."""
 
 FLUID_COLUMNS = ("u_inlet", "pressure_drop", "bed_height")
 GAS_COLUMNS = ("T_gas_mean", "gas_energy", "heat_convected", "heat_convected_gross", "heat_through_fluid_boundaries",
@@ -59,6 +66,24 @@ def layer_pressure_drop(fluid, up) -> float:
     return float(p[h < h.min() + tol].mean() - p[h > h.max() - tol].mean())
 
 
+def per_rank_grid(loop, fluid):
+    """The fluid mesh's grid (``fluid_ranks.BoxGrid``) when the exchange can be done on each
+    rank (``ON_RANKS``): the host's own box case (a user's case is gathered), with its
+    ``cell`` interpolation (controlDict's particleInterpolation), the ``centre`` void fraction
+    and no convection (each of those needs the gathered particles); else None."""
+    from foamlib import FoamFile
+
+    from pyhost.engines.fluid_ranks import BoxGrid
+
+    wanted = loop.dem.link is not None if ON_RANKS is None else ON_RANKS
+    if not wanted or loop.scene.fluid.case or fluid.void_fraction != "centre" or loop.effects["convection"]:
+        return None
+    if FoamFile(fluid.case / "system" / "controlDict").get("particleInterpolation", "cell") != "cell":
+        return None
+    points = np.asarray(FoamFile(fluid.case / "constant" / "polyMesh" / "points")[None], float).reshape(-1, 3)
+    return BoxGrid.of(points, fluid.cell_centres)
+
+
 class FluidExchange(Effect):
     """``fluid``: the running solver (pyhost.engines.openfoam.FluidSolver, the context's
     ``fluid``); its interval: ``couple``, every time.couple_every DEM steps."""
@@ -86,6 +111,7 @@ class FluidExchange(Effect):
             self.inlet = inlet_speed(fluid.case, start_time(fluid.case)[1] or "0")
         link = loop.dem.link
         self.overlap = overlapping(loop.scene.fluid.overlap, 1 if link is None else link.size, loop.scene.fluid.ranks)
+        self.grid = per_rank_grid(loop, fluid)     # not None: each rank does its particles' part
 
     def start(self) -> None:
         if self.loop.scene.fluid.case:
@@ -119,6 +145,8 @@ class FluidExchange(Effect):
         """The fluid's force on each particle from the current fluid, then the fluid advanced
         over the next coupling interval with these particles' fraction and drag (with
         ``overlap``, while the DEM runs that interval: the next use of the fluid waits for it)."""
+        if self.grid is not None:
+            return self.couple_on_ranks()
         loop = self.loop
         atoms = loop.dem.atoms(temperature=self.convection)
         lo, hi, periodic = loop.dem.box()
@@ -136,6 +164,33 @@ class FluidExchange(Effect):
                            heat=self.convect(atoms, interval) if self.convection else None, wait=not self.overlap)
         loop.dem.set_force(forces)
         self.force = (atoms.id.copy(), forces)
+
+    def couple_on_ranks(self) -> None:
+        """``couple`` with each rank's particles on their rank (``pyhost.engines.fluid_ranks``):
+        rank 0 sends every rank the fluid of each cell and gets back each cell's sums over the
+        particles, O(cells); a particle outside the mesh or with its drag unresolved fails the
+        run as in ``couple``, named as there."""
+        from pyhost.engines.dem import FLUID_FIX
+        from pyhost.engines.fluid_ranks import Job, exchange_on_rank
+
+        loop, fluid, grid = self.loop, self.fluid, self.grid
+        lo, hi, periodic = loop.dem.box()
+        interval = loop.every["couple"] * loop.dem.dt
+        u, gradp = fluid.cell_fluid()
+        job = Job(grid.faces, grid.to_grid(u), grid.to_grid(gradp), grid.to_grid(fluid.cell_volumes), lo, hi,
+                  periodic, fluid.rho, fluid.nu, fluid.drag, fluid.alpha_min, interval, FLUID_FIX)
+        parts = loop.dem.each_rank(exchange_on_rank, job)
+        if any("outside" in p for p in parts):      # a failed simulation (exit 3), not bad input
+            ids, x, v = (np.concatenate([p["outside"][k] for p in parts]) for k in range(3))
+            raise left_the_mesh(ids, x, v, loop.t)
+        if any(len(p["unresolved"][0]) for p in parts):     # (their forces are set: the run stops here)
+            ids, k, mass, d = (np.concatenate([p["unresolved"][c] for p in parts]) for c in range(4))
+            raise drag_unresolved(ids, k, mass, d, interval, loop.dem.dt, loop.t)
+        sums = parts[0]
+        fluid.take_particles(fluid_fraction(grid.to_solver(sums["solid"]), fluid.cell_volumes, fluid.alpha_min),
+                             grid.to_solver(sums["ksum"]), grid.to_solver(sums["kv"]))
+        fluid.advance(interval, fluid.substeps(interval), wait=not self.overlap)
+        self.force = None               # on the ranks: gathered only for a checkpoint (``state``)
 
     def convect(self, atoms, interval: float) -> np.ndarray:
         """Gas-particle heat over the coming interval [s] (plugins.convection): each particle's
@@ -182,8 +237,14 @@ class FluidExchange(Effect):
             inlet = self.inlet(loop.t) if self.inlet is not None else math.nan
         else:
             inlet = float(loop.scene.fluid.inlet_at(loop.t))
-        return (inlet, layer_pressure_drop(self.fluid, up) + head,
-                2.0 * float(np.mean(atoms.x @ up - floor)) if len(atoms.x) else math.nan)
+        if self.grid is not None:       # summed on each rank (pyhost.engines.fluid_ranks)
+            from pyhost.engines.fluid_ranks import height_on_rank
+            parts = loop.dem.each_rank(height_on_rank, up, floor)
+            total, n = sum(p[0] for p in parts), sum(p[1] for p in parts)
+            height = 2.0 * (total / n) if n else math.nan
+        else:
+            height = 2.0 * float(np.mean(atoms.x @ up - floor)) if len(atoms.x) else math.nan
+        return inlet, layer_pressure_drop(self.fluid, up) + head, height
 
     def gas_state(self) -> tuple:
         """The gas columns of history.csv: the heat-capacity weighted mean gas temperature [K],
@@ -213,6 +274,11 @@ class FluidExchange(Effect):
             self.frames.flush()
 
     def state(self) -> tuple[dict, dict]:
+        if self.force is None:          # the exchange on the ranks: their forces now, as set there
+            from pyhost.engines.dem import FLUID_FIX
+            from pyhost.engines.fluid_ranks import force_on_rank
+            parts = self.loop.dem.each_rank(force_on_rank, FLUID_FIX)
+            self.force = tuple(np.concatenate([p[k] for p in parts]) for k in range(2))
         return (dict(gas_energy0=self.gas_energy0, logs=dict(fluid=self.frames.frames if self.frames else None)),
                 dict(fluid_ids=self.force[0], fluid_force=self.force[1]))
 

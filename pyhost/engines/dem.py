@@ -27,7 +27,7 @@ from pyhost.collisions import wall_code
 from pyhost.engines.atoms import Atoms, local_view
 from pyhost.engines.liggghts import Liggghts, LiggghtsError
 from pyhost.engines.collective import collective
-from pyhost.engines.ranks import (gather_arrays, local_atoms, local_atoms_of, local_random_states,
+from pyhost.engines.ranks import (ENGINE, gather_arrays, local_atoms, local_atoms_of, local_random_states,
                                   local_snapshot, local_values, put_by_id, set_random_states, write_local)
 from pyhost.engines.liggghts.script import Command, ScriptError, ScriptInfo, output_files
 
@@ -408,10 +408,12 @@ class Dem:
         by name) on every rank, on its own atoms (``local_view``: LIGGGHTS' memory, T writable)
         and contact events; the ranks' results in rank order (serially: the one result, in a
         list, comm None). What the host changed in gathered atoms goes back first."""
+        ENGINE[0] = self.lmp            # (ranks.ENGINE: for a func that needs more than the atoms)
         if self.link is None:
-            return [func(local_view(self.lmp), self.events, None, *args)]
-        self._order("each_rank", func, args)
-        mine = func(local_view(self.lmp), self.events.local, self.link.comm, *args)
+            return [func(local_view(self.lmp, self.heat), self.events, None, *args)]
+        self._order("each_rank", func, args, self.heat)    # (T None without heat: LIGGGHTS has no Temp then)
+        mine = func(local_view(self.lmp, self.heat), None if self.events is None else self.events.local,
+                    self.link.comm, *args)
         self._pending = None            # func may change the atoms' Temp: a gathered copy is out of date
         return self.link.gather(mine)
 

@@ -33,6 +33,7 @@ import numpy as np
 from foamlib import FoamFile
 
 from plugins import drag as drag_laws
+from plugins.drag import fluid_force, fluid_fraction
 from pyhost.engines.fluid_case import is_time_name, start_time
 
 # The solver built by tools/setup_engines.sh; COLLHEAT_SOLVER names another build (a variant under test).
@@ -405,19 +406,49 @@ class FluidSolver:
         else:
             cells, share = cell[:, None], np.ones((len(x), 1))
         spread = lambda w: np.bincount(cells.ravel(), weights=(w[:, None] * share).ravel(), minlength=ncells)
-        solid = spread(vp) / self.cell_volumes
-        alpha = np.maximum(1.0 - solid, self.alpha_min)
+        alpha = fluid_fraction(spread(vp), self.cell_volumes, self.alpha_min)
         slip = u - v
         self.cell, self.slip = cell, np.linalg.norm(slip, axis=1)
         k = self.drag_law(np.sum(alpha[cells] * share, axis=1), self.slip, d, self.rho, self.nu)
         self.exchange = k
         ksum = spread(k)
         kv = np.stack([spread(k * v[:, i]) for i in range(3)], axis=1)
+        self.take_particles(alpha, ksum, kv)
+        return fluid_force(k, slip, vp, self.rho, gradp)
+
+    def take_particles(self, alpha: np.ndarray, ksum: np.ndarray, kv: np.ndarray) -> None:
+        """The particle fields of the next :meth:`advance` from each cell's sums over its
+        particles (``particle_forces``'s, or the MPI ranks' summed: ``pyhost.engines.fluid_ranks``):
+        ``alpha`` the fluid fraction (:func:`fluid_fraction`), ``ksum`` the drag coefficients
+        K [kg/s] summed, ``kv`` K v summed [kg m/s^2] (n, 3). The cells' Ksl = ksum / V
+        [kg/(m^3 s)] and the particles' drag-weighted velocity Us = kv / ksum [m/s] (0 where no
+        particle)."""
         self._alpha = alpha
         self._ksl = ksum / self.cell_volumes
         self._us = np.divide(kv, ksum[:, None], out=np.zeros(kv.shape), where=ksum[:, None] > 0)   # float
         # also with no particle yet (a script that inserts later): bincount of nothing is int
-        return k[:, None] * slip - (vp * self.rho)[:, None] * gradp
+
+    @_exchange
+    def cell_fluid(self) -> tuple[np.ndarray, np.ndarray]:
+        """The fluid velocity [m/s] and kinematic pressure gradient [m/s^2] of every cell, in
+        the order of ``cell_centres``, as :meth:`locate` gives them to a particle in that cell
+        under the ``cell`` interpolation (OpenFOAM's interpolationCell returns the cell's value
+        wherever in it the point is): a LOCATE of each rank's own cell centres, to that rank
+        only, O(cells). FluidError if a centre is not found in its own cell (not a mesh of
+        convex cells)."""
+        for rank in range(self.nprocs):
+            a, b = self.offsets[rank], self.offsets[rank + 1]
+            self._send(rank, np.array([LOCATE, b - a, 0], np.int32).tobytes() + self.cell_centres[a:b].tobytes())
+        u, gradp = [], []
+        for rank, nc in enumerate(self.rank_cells):
+            c = self._read(rank, np.int32, nc)
+            u.append(self._read(rank, np.float64, 3 * nc).reshape(nc, 3))
+            gradp.append(self._read(rank, np.float64, 3 * nc).reshape(nc, 3))
+            if not np.array_equal(c, np.arange(nc)):
+                wrong = int(np.flatnonzero(c != np.arange(nc))[0])
+                raise FluidError(f"the fluid solver's rank {rank} finds the centre of its cell {wrong} in cell "
+                                 f"{int(c[wrong])}: the mesh has cells that do not hold their centre")
+        return np.concatenate(u), np.concatenate(gradp)
 
     @_exchange
     def locate(self, x: np.ndarray, strict: bool = True,

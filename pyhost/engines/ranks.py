@@ -24,6 +24,9 @@ import numpy as np
 from pyhost.engines.atoms import local_view
 
 ROOT = 0
+ENGINE = [None]
+"""This process's LIGGGHTS while a ``Dem.each_rank`` function runs on it (rank 0's and each
+follower's): for a function that needs more than its atoms (the fluid's force fix)."""
 
 
 def world():
@@ -275,9 +278,11 @@ class Follower:
     def do_snapshot(self) -> None:
         gather_arrays(self.comm, self.snap)
 
-    def do_each_rank(self, func, args) -> None:
+    def do_each_rank(self, func, args, temperature=True) -> None:
         """``Dem.each_rank``: ``func`` on this rank's atoms and events, its result to rank 0."""
-        self.comm.gather(func(local_view(self.lmp), self.events, self.comm, *args), root=ROOT)
+        ENGINE[0] = self.lmp
+        self.comm.gather(func(local_view(self.lmp, temperature), getattr(self, "events", None), self.comm, *args),
+                         root=ROOT)
 
     def do_write(self, force_fix) -> None:
         write_local(self.lmp, *self.comm.scatter(None, root=ROOT), force_fix=force_fix, rows=getattr(self, "rows", None))
