@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import hashlib
+import importlib
 import json
 import math
 import os
@@ -20,7 +21,6 @@ import sys
 import time
 from pathlib import Path
 
-import meshio
 import numpy as np
 
 from pyhost import signals
@@ -395,12 +395,22 @@ def _output_writer():
     return _writer
 
 
-def _write_frame(path: Path, mesh) -> None:
+def preload() -> None:
+    """meshio imported by the output thread now (0.1-0.25 s: it imports every format it reads
+    and its command line's libraries), while the caller goes on to start the engines, whose
+    calls release the GIL; the first frame finds it loaded (``_write_frame``)."""
+    _output_writer().submit(importlib.import_module, "meshio")
+
+
+def _write_frame(path: Path, points, cells, point_data) -> None:
     """One frame's file, named if it cannot be written (a full disk), and then removed: the
-    index never names a half frame."""
+    index never names a half frame. (In the output thread: the run's own thread never imports
+    meshio.)"""
+    import meshio
+
     try:
         with naming(path):
-            meshio.write(path, mesh)
+            meshio.write(path, meshio.Mesh(points, cells, point_data=point_data))
     except BaseException:
         path.unlink(missing_ok=True)
         raise
@@ -437,8 +447,8 @@ class VtkSeries:
         file = f"{self.name}_{len(self.frames):05d}.vtu"
         points = np.array(points, float)
         cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
-        mesh = meshio.Mesh(points, cells, point_data={k: np.array(v) for k, v in point_data.items()})
-        self._pending = _output_writer().submit(_write_frame, self.folder / file, mesh)
+        self._pending = _output_writer().submit(_write_frame, self.folder / file, points, cells,
+                                                {k: np.array(v) for k, v in point_data.items()})
         self.frames.append((t, file))
         if time.monotonic() - self._indexed >= self.INDEX_EVERY:
             self._index()

@@ -92,6 +92,9 @@ def run_case(args, link) -> int:
     if link is not None:
         print(f"MPI: LIGGGHTS on {link.size} ranks; the host on rank 0")
     pictures = painter(out) if scene.output.pictures else None   # own process, warming up meanwhile
+    if scene.output.vtk:
+        from pyhost.output import preload
+        preload()                       # the frames' writer, loaded while the engines start
     try:
         summary = simulate(scene, out, test=args.test, resume=resume, extend=extend, link=link)
     except BaseException:

@@ -12,7 +12,6 @@ import numpy as np
 
 from plugins import convection
 from pyhost.effects import Effect, by_id
-from pyhost.engines.openfoam import OutsideMesh
 from pyhost.failures import drag_unresolved, left_the_mesh
 from pyhost.output import VtkSeries
 
@@ -119,6 +118,8 @@ class FluidExchange(Effect):
         """The fluid's force on each particle from the current fluid, then the fluid advanced
         over the next coupling interval with these particles' fraction and drag (with
         ``overlap``, while the DEM runs that interval: the next use of the fluid waits for it)."""
+        from pyhost.engines.openfoam import OutsideMesh  # (loaded with the solver; every run imports this module's TOTALS)
+
         loop = self.loop
         atoms = loop.dem.atoms(temperature=self.convection)
         lo, hi, periodic = loop.dem.box()
