@@ -118,21 +118,3 @@ def test_a_command_imports_its_own_module_only():
     top = subprocess.run([sys.executable, "-m", "pyhost", "--help"], capture_output=True, text=True, timeout=60)
     from pyhost.cli import COMMANDS
     assert top.returncode == 0 and all(name in top.stdout for name in COMMANDS)
-
-
-def test_a_dry_run_imports_neither_foamlib_nor_meshio_in_its_own_thread():
-    """A run's start loads what its scene needs: a dry scene (a box, a user's script) with
-    every effect's module loaded for the totals imports no foamlib (0.1-0.2 s: CFDEM and fluid
-    cases only), and the frames' meshio (0.1-0.25 s) is imported by the output thread
-    (``output.preload``) while the engines start, not by the run's own thread."""
-    probe = ("import sys\nfrom pathlib import Path\nfrom pyhost.scene import load_scene\n"
-             "import pyhost.commands.run, pyhost.world, pyhost.run_scene, pyhost.effects as e\n"
-             "for case in ('hot-cold-box', 'silo-heat'):\n"
-             "    load_scene(Path('cases', case, 'case.toml').absolute())\n"
-             "e.totals()\n"
-             "before = sorted(m for m in ('foamlib', 'meshio') if m in sys.modules)\n"
-             "from pyhost import output\noutput.preload()\noutput._output_writer().submit(int).result()\n"
-             "print(before, 'meshio' in sys.modules)")
-    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=60, cwd=Path(__file__).resolve().parents[2])
-    assert r.returncode == 0, r.stderr
-    assert r.stdout.strip().splitlines()[-1] == "[] True", r.stdout
