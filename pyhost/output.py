@@ -427,6 +427,11 @@ def _output_writer():
     return _writer
 
 
+def later(fn, *args):
+    """``fn(*args)`` done by the output thread, after what was handed to it before; its future."""
+    return _output_writer().submit(fn, *args)
+
+
 def preload() -> None:
     """meshio imported by the output thread now (0.1-0.25 s: it imports every format it reads
     and its command line's libraries), while the caller goes on to start the engines, whose
