@@ -1,6 +1,7 @@
 """Pictures of a run, made from what it wrote: history plots and a rendered last frame."""
 from __future__ import annotations
 
+import copy
 import csv
 import ctypes.util
 import os
@@ -194,7 +195,13 @@ def render_particles(out: Path) -> Path:
             print(f"note: fluid fraction not drawn: {exc}")
     has_fluid = grid is not None
     window = WINDOW_FLUID if has_fluid else WINDOW
-    plotter = pyvista.Plotter(off_screen=True, window_size=window)
+    # edges smoothed by FXAA, a pass over the finished image, not by 8 samples a pixel (pyvista's
+    # default): Mesa's software renderer took 0.75 s CPU for 900 spheres with those, 0.35 s now
+    # (pyvista's enable_anti_aliasing("fxaa") falls back to supersampling off screen; VTK's works)
+    theme = copy.deepcopy(pyvista.global_theme)
+    theme.multi_samples = 0
+    plotter = pyvista.Plotter(off_screen=True, window_size=window, theme=theme)
+    plotter.renderer.SetUseFXAA(True)
     bar = dict(vertical=True, width=0.05, height=0.5, position_y=0.25, title_font_size=14, label_font_size=14)
     title = f"temperature change [{unit}]"
     # a sprite of the particles' mean diameter as seen at the window's height across the scene

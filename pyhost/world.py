@@ -165,6 +165,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
     from pyhost.engines.liggghts.script import check_types, read_script
 
     effects = scene.effects_summary()
+    pending = []                        # a box scene's data file, being written while LIGGGHTS starts
     driven = driven_time(scene) if scene.scripted and effects["fluid_solver"] else None
     max_time = (scene.time.test_end or (driven / 10 if driven else None)) if (test and scene.scripted) else None
     if max_time is not None:            # a smoke run extended: its cut as much later
@@ -177,7 +178,7 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         if scene.time.dem_step > t_c / 20:
             print(f"warning: time.dem_step = {scene.time.dem_step:g} s resolves a 1 m/s DEM collision "
                   f"({t_c:.3g} s) with fewer than 20 steps")
-        script, particles = box_world(scene, out, start, resume and resume["restart"])
+        script, particles = box_world(scene, out, start, resume and resume["restart"], pending)
         variables = {}
     particles["resume"] = resume
     commands = read_script(script, scene.folder, effects["particle_temperatures"])
@@ -190,6 +191,8 @@ def simulate(scene, out: Path, *, test: bool = False, progress_every: float = 5.
         os.chdir(scene.folder)          # the script's relative paths, as with 'liggghts -in' there
         dem = Dem(out / "dem", variables=variables, link=link)
         try:
+            for written in pending:
+                written.result()
             return run_scene(scene, wrap(dem) if wrap else dem, commands, out, script=script, max_time=max_time,
                              fluid=wrap_fluid(fluid) if wrap_fluid and fluid is not None else fluid,
                              end=None if scene.scripted else scene.time.end, driven=driven, extend=extend,

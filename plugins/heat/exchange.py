@@ -54,13 +54,23 @@ def exchange_heat(T, C, i, j, G, T_wall=None, shift=None):
     moved = np.zeros(len(G))
     # the second body of a wall collision: a code of its own that no particle shares
     other = np.where(wall, -1 - np.arange(len(j)), j)
-    left = active
+    # each active collision's previous one of each of its two bodies (a position in ``active``;
+    # -1: none), from one sort: a collision is the first remaining one of a body when that
+    # body's previous one is done (sorting what remains at each round took 0.3 s a harvest of
+    # a 27,000-sphere gas, 70,000 collisions)
+    ends = np.stack([i[active], other[active]], axis=1).ravel()
+    order = np.argsort(ends, kind="stable")
+    after = ends[order[1:]] == ends[order[:-1]]
+    prev = np.full(len(ends), -1)
+    prev[order[1:][after]] = order[:-1][after] // 2
+    prev = prev.reshape(-1, 2)
+    done = np.zeros(len(active) + 1, bool)
+    done[-1] = True                      # (prev -1: no previous collision)
+    left = np.arange(len(active))
     while len(left):
-        ends = np.stack([i[left], other[left]], axis=1).ravel()
-        first = np.zeros(len(ends), bool)
-        first[np.unique(ends, return_index=True)[1]] = True
-        now = first.reshape(-1, 2).all(axis=1)
-        k = left[now]
+        now = done[prev[left, 0]] & done[prev[left, 1]]
+        done[left[now]] = True
+        k = active[left[now]]
         a, b, pair = i[k], j[k], ~wall[k]
         q = g[k] * (T[a] - np.where(pair, T[np.where(pair, b, a)], tw[k]) + (0.0 if shift is None else shift[k]))
         T[a] -= q / C[a]

@@ -29,6 +29,45 @@ def run(args) -> int:
     return 0
 
 
+def draw_both(out: Path) -> int:
+    """What a ``painter`` draws when told: the history's plot in a forked copy of this process
+    while this one renders the particles (0.25-0.35 s and 0.5-1 s, each on its core: the run is
+    over, its process waits for these). The copy only draws with matplotlib (VTK's context stays
+    this process's) and ends with ``os._exit``; its exit code is the pictures' if it fails."""
+    import os
+    import sys
+
+    from pyhost.cli import UserError
+    from pyhost.pictures import plot_history, render_particles
+
+    if not (out / "history.csv").exists():
+        raise UserError(f"{out}: no history.csv: not the output folder of a run")
+    if not (out / "vtk" / "particles.pvd").exists():
+        print("pictures:", plot_history(out))
+        return 0
+    sys.stdout.flush()
+    pid = os.fork()
+    if pid == 0:
+        code = 1
+        try:
+            made = plot_history(out)
+            print("pictures:", made)
+            code = 0
+        except (UserError, OSError) as exc:
+            from pyhost.exitcodes import classify
+            print(f"error: {classify(exc)[1]}", file=sys.stderr)
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(code)
+    try:
+        made = render_particles(out)
+    finally:
+        status = os.waitpid(pid, 0)[1]
+    print("pictures:", made)
+    return os.waitstatus_to_exitcode(status)
+
+
 def painter(out: Path):
     """A picture process for the run writing into ``out``, started now: it imports the drawing
     libraries while the run goes on (on another core) and draws when ``draw(painter)`` is
@@ -61,7 +100,8 @@ if __name__ == "__main__":      # what `run` starts: the same, without building 
         if sys.stdin.readline().strip() != "draw":
             sys.exit(0)                  # the run failed: no pictures
     try:
-        code = run(argparse.Namespace(out=Path(sys.argv[1])))
+        out = Path(sys.argv[1])
+        code = draw_both(out) if sys.argv[2:] == ["--when-told"] else run(argparse.Namespace(out=out))
     except (UserError, OSError) as exc:      # (a full disk: the picture's file named, no traceback)
         from pyhost.exitcodes import classify
         sys.exit(f"error: {classify(exc)[1]}")

@@ -58,6 +58,19 @@ def run(args) -> int:
 
 
 def run_case(args, link) -> int:
+    # The picture process first, before the scene is read: a short run ends waiting for its
+    # warm-up (1.3 s CPU of imports) and drawing. Ended at once where the scene asks for no
+    # pictures, and when the run fails (no pictures of a failed run).
+    pictures = painter((args.out or args.case / "output").resolve())
+    try:
+        return _run_case(args, link, pictures)
+    except BaseException:
+        pictures.kill()
+        pictures.wait()
+        raise
+
+
+def _run_case(args, link, pictures) -> int:
     from pyhost.exitcodes import UserError
     from pyhost.outdir import prepare_output, write_atomic
     from pyhost.scene import load_scene
@@ -91,16 +104,15 @@ def run_case(args, link) -> int:
     print("active effects:", ", ".join(k for k, on in effects.items() if on) or "none (plain DEM)")
     if link is not None:
         print(f"MPI: LIGGGHTS on {link.size} ranks; the host on rank 0")
-    pictures = painter(out) if scene.output.pictures else None   # own process, warming up meanwhile
-    try:
-        summary = simulate(scene, out, test=args.test, resume=resume, extend=extend, link=link)
-    except BaseException:
-        if pictures is not None:      # no pictures of a failed run
-            pictures.kill()
-            pictures.wait()
-        raise
+    if not scene.output.pictures:
+        pictures.kill()
+        pictures.wait()
+    if scene.output.vtk:
+        from pyhost.output import preload
+        preload()                       # the frames' writer, loaded while the engines start
+    summary = simulate(scene, out, test=args.test, resume=resume, extend=extend, link=link)
     print("summary:", json.dumps(summary, indent=1))
-    if pictures is not None:
+    if scene.output.pictures:
         code = draw(pictures)
         if code != 0:
             print(f"warning: pictures failed (exit {code}); the run's data are in {out}")

@@ -11,11 +11,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from foamlib import FoamFile
 
 from pyhost.effects import Effect, by_id
 from pyhost.engines.cfdem_commands import SMALL, read_commands, write_times
-from pyhost.engines.fluid_case import start_time
 from pyhost.engines.liggghts.script import Command
 
 
@@ -36,6 +34,9 @@ class CaseCommands(Effect):
         commands = read_commands(case, loop.scene.time.couple_every)
         if not commands:
             return None
+        from foamlib import FoamFile    # (here: foamlib costs 0.1-0.2 s, and every run imports this module's TOTALS)
+        from pyhost.engines.fluid_case import start_time
+
         control = FoamFile(case / "system" / "controlDict").as_dict()
         start = start_time(case)[0]
         driven = loop.driven if loop.driven is not None else float(control["endTime"]) - start

@@ -13,7 +13,6 @@ import numpy as np
 from plugins import convection
 from plugins.drag import fluid_fraction
 from pyhost.effects import Effect, by_id
-from pyhost.engines.openfoam import OutsideMesh
 from pyhost.failures import drag_unresolved, left_the_mesh
 from pyhost.output import VtkSeries
 
@@ -147,6 +146,8 @@ class FluidExchange(Effect):
         ``overlap``, while the DEM runs that interval: the next use of the fluid waits for it)."""
         if self.grid is not None:
             return self.couple_on_ranks()
+        from pyhost.engines.openfoam import OutsideMesh  # (loaded with the solver; every run imports this module's TOTALS)
+
         loop = self.loop
         atoms = loop.dem.atoms(temperature=self.convection)
         lo, hi, periodic = loop.dem.box()

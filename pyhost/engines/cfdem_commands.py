@@ -26,7 +26,6 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from pyhost.engines.fluid_case import cfdem_dict, entry_line
 from pyhost.engines.liggghts.script import host_fix_refusal
 
 SMALL = 1e-15
@@ -138,6 +137,8 @@ def read_commands(case: str | Path, couple_every: int) -> list[CaseCommand]:
     path = Path(case) / "constant" / "liggghtsCommands"
     if not path.is_file():
         return []
+    from pyhost.engines.fluid_case import cfdem_dict, entry_line   # (foamlib: 0.1-0.2 s, CFDEM cases only)
+
     f = cfdem_dict(path)
     models = [str(m) for m in (f.get("liggghtsCommandModels") or [])]
     if "runLiggghts" not in models:

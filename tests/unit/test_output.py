@@ -25,6 +25,28 @@ def test_csv_rows_are_on_disk_before_close(tmp_path):
     log.close()
 
 
+def test_csv_columns_are_the_bytes_csv_writer_writes(tmp_path):
+    """Columns are formatted without csv.writer where no value needs quotes (output._csv_lines):
+    the file is byte for byte what csv.writer writes from the same rows, with floats at every
+    digit, signed zeros, NaN and infinities, integers and text, and text that needs quotes."""
+    rng = np.random.default_rng(3)
+    n = CsvLog.CHUNK + 11
+    x = rng.normal(0.0, 1.0, n) * 10.0 ** rng.integers(-300, 300, n)
+    x[:4] = [-0.0, np.nan, np.inf, 1e-7]
+    cols = dict(t=x, step=rng.integers(-2**62, 2**62, n), model=np.where(rng.random(n) < 0.5, "A", "exact B"),
+                small=rng.normal(0.0, 1.0, n).astype(np.float32))
+    quoted = dict(cols, model=np.where(rng.random(n) < 0.5, "A", 'say "B", \r\nthen C'))
+    for name, columns in (("plain", cols), ("quoted", quoted)):
+        log = CsvLog(tmp_path / f"{name}.csv", tuple(columns))
+        log.write_columns(**columns)
+        log.close()
+        expected = io.StringIO(newline="")
+        writer = csv.writer(expected)
+        writer.writerow(tuple(columns))
+        writer.writerows(zip(*(c.tolist() for c in columns.values())))
+        assert (tmp_path / f"{name}.csv").read_bytes() == expected.getvalue().encode()
+
+
 def test_csv_rows_are_written_from_copies_in_order(tmp_path):
     """The output thread writes the columns as they were when given, in the order given, in
     chunks of CHUNK rows: the caller may change its arrays at once (the next batch)."""

@@ -130,3 +130,19 @@ def test_no_x_server_warning_without_a_display(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "X server" not in r.stderr and r.stderr == "", r.stderr
     assert (tmp_path / "particles.png").stat().st_size > 0 and (tmp_path / "temperatures.png").stat().st_size > 0
+
+
+def test_the_painter_draws_the_history_in_a_forked_copy_and_reports_its_failure(tmp_path):
+    """Told to draw, the painter plots the history in a forked copy while it renders the
+    particles (``draw_both``): a history plot that cannot be written (its file's place taken
+    by a folder) fails the pictures (non-zero exit, the file named on stderr), and the
+    particles are drawn all the same."""
+    from pyhost.commands.pictures import draw
+
+    write_run(tmp_path, fluid=False)
+    (tmp_path / "temperatures.png").mkdir()
+    p = subprocess.Popen([sys.executable, "-m", "pyhost.commands.pictures", str(tmp_path), "--when-told"],
+                         stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+    code = draw(p)
+    assert code != 0 and str(tmp_path / "temperatures.png") in p.stderr.read().decode()
+    assert (tmp_path / "particles.png").stat().st_size > 0
