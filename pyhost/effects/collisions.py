@@ -144,7 +144,11 @@ class CollisionHeat(Effect):
             due["couple"] and (convects or bool(self.dem.events.window)))
 
     def end_run(self) -> None:
-        """At the end of each of the script's runs: the events so far."""
+        """At the end of each of the script's runs: the events so far (under MPI without a fix
+        heat/gran, on the atoms of those events only: ``harvest_partly``)."""
+        if self.dem.link is not None and not self.dem.events.window:
+            self.harvest_partly()
+            return
         self.harvest(self.dem.atoms(self.loop.heat))
 
     def state(self) -> tuple[dict, dict]:

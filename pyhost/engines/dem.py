@@ -403,15 +403,17 @@ class Dem:
         return cols
 
     @collective
-    def each_rank(self, func, *args) -> list:
+    def each_rank(self, func, *args, temperature: bool = True) -> list:
         """``func(atoms, events, comm, *args)`` (a module-level function: the followers import it
-        by name) on every rank, on its own atoms (``local_view``: LIGGGHTS' memory, T writable)
-        and contact events; the ranks' results in rank order (serially: the one result, in a
-        list, comm None). What the host changed in gathered atoms goes back first."""
+        by name) on every rank, on its own atoms (``local_view``: LIGGGHTS' memory, T writable;
+        None without ``temperature``) and contact events (None if not recorded); the ranks'
+        results in rank order (serially: the one result, in a list, comm None). What the host
+        changed in gathered atoms goes back first."""
         if self.link is None:
-            return [func(local_view(self.lmp), self.events, None, *args)]
-        self._order("each_rank", func, args)
-        mine = func(local_view(self.lmp), self.events.local, self.link.comm, *args)
+            return [func(local_view(self.lmp, temperature), self.events, None, *args)]
+        self._order("each_rank", func, args, temperature)
+        events = self.events.local if self.events is not None else None
+        mine = func(local_view(self.lmp, temperature), events, self.link.comm, *args)
         self._pending = None            # func may change the atoms' Temp: a gathered copy is out of date
         return self.link.gather(mine)
 
