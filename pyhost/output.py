@@ -430,9 +430,14 @@ class VtkSeries:
             self._index()
 
     def _remove_later(self, kept: set) -> None:
-        """The frame files a checkpoint's frames do not name (written after it) removed."""
-        for old in self.folder.glob(f"{self.name}_*.vtu"):
-            if old.name not in kept:
+        """The frame files a checkpoint's frames do not name (written after it) removed: .vtu
+        frames, and .pvtu frames with their pieces (``PieceSeries``: a checkpoint of a run on
+        several ranks may go on on one, and the other way round)."""
+        import re
+        stems = {Path(f).stem for f in kept}
+        for old in sorted(self.folder.glob(f"{self.name}_*.vtu")) + sorted(self.folder.glob(f"{self.name}_*.pvtu")):
+            piece = re.fullmatch(r"(.*_\d{5})_p\d+", old.stem)       # a rank's piece of a frame
+            if old.name not in kept and (piece is None or piece.group(1) not in stems):
                 old.unlink()
 
     def write(self, t: float, points, **point_data) -> Path:
@@ -519,14 +524,6 @@ class PieceSeries(VtkSeries):
         self.ranks = ranks
         self.written = len(frames or [])         # frames whose every piece is on disk
         super().__init__(folder, name, frames)
-
-    def _remove_later(self, kept: set) -> None:
-        import re
-        stems = {Path(f).stem for f in kept}
-        for old in list(self.folder.glob(f"{self.name}_*.vtu")) + list(self.folder.glob(f"{self.name}_*.pvtu")):
-            piece = re.fullmatch(r"(.*_\d{5})_p\d+", old.stem)       # a rank's piece of a frame
-            if old.name not in kept and (piece is None or piece.group(1) not in stems):
-                old.unlink()
 
     def next_frame(self) -> int:
         """The number of the frame to be written next."""

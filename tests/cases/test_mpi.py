@@ -54,7 +54,8 @@ def pair_across_the_boundary(tmp_path):
 def test_contact_events_of_a_pair_across_the_rank_boundary_equal_the_serial_run(tmp_path):
     """The same pair on contact events: the rank owning the smaller id records it, rank 0 joins
     the ranks' events. The collision row (impact speed at touch, heat, e, t_coll) and the
-    history are the serial run's bit for bit. Restitution feedback: the recorder changes only
+    history are the serial run's bit for bit, and so are the frames, written in pieces on the
+    two ranks and read back (``assert_frames_equal``). Restitution feedback: the recorder changes only
     its own rank's atoms, so the separation speed e v0 of a pair on two ranks is imposed by the
     host at the harvest after the end (restitution_late, 1 here) instead of at the end's step."""
     case = pair_across_the_boundary(tmp_path)
@@ -66,6 +67,30 @@ def test_contact_events_of_a_pair_across_the_rank_boundary_equal_the_serial_run(
     assert parallel == serial
     for name in ("collisions.csv", "history.csv"):
         assert (tmp_path / "np2" / name).read_bytes() == (tmp_path / "np1" / name).read_bytes(), name
+    assert_frames_equal(tmp_path / "np1" / "vtk", tmp_path / "np2" / "vtk", ranks=2)
+
+
+def assert_frames_equal(serial, parallel, ranks):
+    """The frames of a run on ``ranks`` ranks, each written in pieces (one .vtu per rank, a
+    .pvtu naming them, the .pvd listing the .pvtu files), read back by pyvista: the serial
+    run's frames (one .vtu each), point for point once sorted by id, every array bit for bit,
+    at the same times."""
+    import pyvista
+
+    one, many = pyvista.get_reader(str(serial / "particles.pvd")), pyvista.get_reader(str(parallel / "particles.pvd"))
+    assert many.time_values == one.time_values and len(one.time_values) > 2
+    files = sorted(p.name for p in parallel.glob("particles_*"))
+    frames = len(one.time_values)
+    assert files == sorted([f"particles_{k:05d}.pvtu" for k in range(frames)]
+                           + [f"particles_{k:05d}_p{r}.vtu" for k in range(frames) for r in range(ranks)])
+    for k in range(frames):
+        a, b = (pyvista.read(str(folder / name)) for folder, name in
+                ((serial, f"particles_{k:05d}.vtu"), (parallel, f"particles_{k:05d}.pvtu")))
+        assert sorted(a.point_data.keys()) == sorted(b.point_data.keys())
+        ia, ib = np.argsort(a["id"]), np.argsort(b["id"])
+        assert np.array_equal(a.points[ia], b.points[ib]), k
+        for name in a.point_data.keys():
+            assert b[name].dtype == a[name].dtype and np.array_equal(a[name][ia], b[name][ib]), (k, name)
 
 
 @pytest.mark.long
