@@ -45,6 +45,18 @@ def rank_effects_only(loop) -> bool:
     return loop.dem.link is not None and len(loop.present) == sum(loop.find(n) is not None for n in RANK_EFFECTS)
 
 
+def cold_message(where, i, t, name: str, T: float) -> str:
+    """A particle starting at or below 0 K (``track``, ``track_on_rank``)."""
+    return (f"{where}: particle {i} (type {t}, materials.{name}) starts at {T:g} K: temperatures must be above 0 K; "
+            f"give materials.{name}.temperature, or the script's fix heat/gran initial_temperature")
+
+
+def density_message(where, i, t, name: str, rho: float, want: float) -> str:
+    """A script's particle whose density is not its material's (``check_densities``)."""
+    return (f"{where}: particle {i} (type {t}) has the script's density {rho:.6g} kg/m^3, "
+            f"materials.{name}.density is {want:g}: give both the same value")
+
+
 @dataclass(frozen=True)
 class RankTrack:
     """What each rank needs to bring the balance up to date with its own atoms
@@ -200,9 +212,7 @@ class EnergyBalance(Effect):
             if cold.any():
                 k = np.flatnonzero(cold)[0]
                 name = list(loop.scene.materials)[mat[k]]
-                raise ScriptError(f"{loop.scene.path}: particle {atoms.id[k]} (type {atoms.type[k]}, materials.{name}) "
-                                  f"starts at {atoms.T[k]:g} K: temperatures must be above 0 K; give "
-                                  f"materials.{name}.temperature, or the script's fix heat/gran initial_temperature")
+                raise ScriptError(cold_message(loop.scene.path, atoms.id[k], atoms.type[k], name, atoms.T[k]))
             if loop.scene.scripted:
                 self.check_densities(atoms, new, mat)
             totals["inserted"] += int(new.sum())
@@ -298,14 +308,10 @@ class EnergyBalance(Effect):
             loop.materials_of(np.array(problem[1]))         # (TypeMaterials' own message)
         if problem[0] == "cold":
             _, i, t, mat, T = problem
-            raise ScriptError(f"{loop.scene.path}: particle {i} (type {t}, materials.{names[mat]}) "
-                              f"starts at {T:g} K: temperatures must be above 0 K; give "
-                              f"materials.{names[mat]}.temperature, or the script's fix heat/gran initial_temperature")
+            raise ScriptError(cold_message(loop.scene.path, i, t, names[mat], T))
         if problem[0] == "density":
             _, i, t, mat, rho, want = problem
-            raise ScriptError(f"{loop.scene.path}: particle {i} (type {t}) has the script's "
-                              f"density {rho:.6g} kg/m^3, materials.{names[mat]}.density is {want:g}: "
-                              "give both the same value")
+            raise ScriptError(density_message(loop.scene.path, i, t, names[mat], rho, want))
 
     def resync(self) -> None:
         """Before each run: heat content that the script's own commands changed since the last
@@ -337,9 +343,8 @@ class EnergyBalance(Effect):
         if len(bad):
             k = np.flatnonzero(new)[bad[0]]
             name = list(loop.scene.materials)[mat[k]]
-            raise ScriptError(f"{loop.scene.path}: particle {atoms.id[k]} (type {atoms.type[k]}) has the script's "
-                              f"density {rho[bad[0]]:.6g} kg/m^3, materials.{name}.density is {want[bad[0]]:g}: "
-                              "give both the same value")
+            raise ScriptError(density_message(loop.scene.path, atoms.id[k], atoms.type[k], name, rho[bad[0]],
+                                              want[bad[0]]))
 
     def check_heat_gran(self) -> None:
         """At each of a script's runs: a fix heat/gran that appeared has its capacities checked

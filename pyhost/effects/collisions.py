@@ -52,8 +52,8 @@ holds the collision rows of all ranks of one harvest at once (some 100 bytes eac
 times over while they are joined, sorted and logged; the dense gas has about 4 collisions per
 particle per 1000 steps), so a gas of 1,000,000 particles harvests every 100 steps instead
 of HARVEST_EVERY (docs/mpi.md: at 1000 steps rank 0 peaked at 2.1 GB and rank 1 at 1.8 GB,
-every 100 steps at 0.83 and 0.73 GB); 100,000 particles and fewer keep HARVEST_EVERY. Without a fix heat/gran the heat moved does not depend
-on the interval (``harvest``)."""
+every 100 steps at 0.83 and 0.73 GB); 100,000 particles and fewer keep HARVEST_EVERY. Without
+the script's conduction the heat moved does not depend on the interval (``harvest``)."""
 
 COLLISION_COLUMNS = ("time", "step", "i", "j", "wall", "v0", "Q", "e", "t_coll", "model")
 
