@@ -228,7 +228,7 @@ class _Lines:
         self.number -= len(lines)
 
 
-VTK_SUFFIXES = (".vtk", ".vtp", ".vtu")
+VTK_SUFFIXES = (".vtk", ".vtp", ".vtu", ".pvtu")      # (.pvtu: a frame written in pieces, one per MPI rank)
 
 
 def expand(paths) -> list:

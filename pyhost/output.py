@@ -5,7 +5,9 @@
   (the collisions with ``output.collisions = "binary"``); ``read_collisions`` reads either
   form as numpy arrays, ``collisions_to_csv`` writes the CSV form of a binary log;
 - ``VtkSeries``: one .vtu per frame (meshio) and a .pvd index rewritten after each frame,
-  so ParaView and pyvista (``pyvista.read(...pvd)``) open whatever was written;
+  so ParaView and pyvista (``pyvista.read(...pvd)``) open whatever was written; under MPI
+  (``PieceSeries``) each rank writes its own piece of a frame (``write_piece``) and rank 0 the
+  frame's .pvtu naming them, which the .pvd lists;
 - ``Progress``: one line every few seconds of wall time: simulated time, rate, time left.
 """
 from __future__ import annotations
@@ -471,11 +473,19 @@ class VtkSeries:
         self._indexed = -math.inf
         self._pending = None           # the frame being written
         if frames is not None:
-            kept = {f for _, f in self.frames}
-            for old in self.folder.glob(f"{self.name}_*.vtu"):
-                if old.name not in kept:
-                    old.unlink()
+            self._remove_later({f for _, f in self.frames})
             self._index()
+
+    def _remove_later(self, kept: set) -> None:
+        """The frame files a checkpoint's frames do not name (written after it) removed: .vtu
+        frames, and .pvtu frames with their pieces (``PieceSeries``: a checkpoint of a run on
+        several ranks may go on on one, and the other way round)."""
+        import re
+        stems = {Path(f).stem for f in kept}
+        for old in sorted(self.folder.glob(f"{self.name}_*.vtu")) + sorted(self.folder.glob(f"{self.name}_*.pvtu")):
+            piece = re.fullmatch(r"(.*_\d{5})_p\d+", old.stem)       # a rank's piece of a frame
+            if old.name not in kept and (piece is None or piece.group(1) not in stems):
+                old.unlink()
 
     def write(self, t: float, points, **point_data) -> Path:
         """Frame at time t [s]: points (n, 3) [m] and per-point arrays, copied (the caller's
@@ -514,6 +524,102 @@ class VtkSeries:
         except BaseException:           # a full disk or a stop: the last whole index stays, no half one
             tmp.unlink(missing_ok=True)
             raise
+
+
+def piece_name(name: str, frame: int, rank: int) -> str:
+    """The file of one rank's piece of a frame of a ``PieceSeries``."""
+    return f"{name}_{frame:05d}_p{rank}.vtu"
+
+
+def piece_mesh(points, point_data: dict):
+    """Points [m] with per-point arrays as a meshio mesh of vertices, copied (the caller's may
+    be the engine's memory, which the next chunk changes)."""
+    points = np.array(points, float).reshape(-1, 3)
+    cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
+    return meshio.Mesh(points, cells, point_data={k: np.array(v) for k, v in point_data.items()})
+
+
+_pieces = {}        # (folder, name) -> this rank's piece being written (write_piece)
+
+
+def write_piece(folder, name: str, frame: int, rank: int, points, **point_data) -> None:
+    """This rank's piece of frame number ``frame`` of the ``PieceSeries`` ``name`` in
+    ``folder``: its own particles, written by its output thread while it goes on (the
+    piece before waits for it first, and raises what it raised). Returns once the piece
+    before this one is on disk (``PieceSeries`` names a frame in its index once every rank
+    has said so: ``wait_piece``)."""
+    wait_piece(folder, name)
+    path = Path(folder) / piece_name(name, frame, rank)
+    _pieces[str(folder), name] = _output_writer().submit(_write_frame, path, piece_mesh(points, point_data))
+
+
+def wait_piece(folder, name: str) -> None:
+    """This rank's last piece of the series on disk (raises what its writing raised)."""
+    pending = _pieces.pop((str(folder), name), None)
+    if pending is not None:
+        pending.result()
+
+
+class PieceSeries(VtkSeries):
+    """A ``VtkSeries`` whose frames are written in pieces, one per MPI rank (each rank its own
+    particles: ``write_piece``), rank 0 writing each frame's .pvtu (the pieces' names and the
+    arrays' types) and the .pvd index of the .pvtu files. A frame is named in the index once
+    every rank's piece is on disk: ``done(k)`` (each rank waited for its frames before k),
+    and at ``flush`` (the caller first has every rank wait: ``wait_piece``)."""
+
+    def __init__(self, folder: Path, name: str, ranks: int, frames: list | None = None):
+        self.ranks = ranks
+        self.written = len(frames or [])         # frames whose every piece is on disk
+        super().__init__(folder, name, frames)
+
+    def next_frame(self) -> int:
+        """The number of the frame to be written next."""
+        return len(self.frames)
+
+    def add(self, t: float, arrays: dict) -> Path:
+        """Frame at time t [s] whose pieces the ranks are writing (``write_piece``, the
+        number ``next_frame()``): its .pvtu, with ``arrays`` (name -> a numpy array of the
+        pieces' dtype and trailing shape, e.g. rank 0's own) naming the arrays' types."""
+        number = len(self.frames)
+        file = f"{self.name}_{number:05d}.pvtu"
+        columns = "".join(f'<PDataArray type="{_vtu_type(a)}" Name="{k}" NumberOfComponents="{_components(a)}"/>\n'
+                          for k, a in arrays.items())
+        pieces = "".join(f'<Piece Source="{piece_name(self.name, number, r)}"/>\n' for r in range(self.ranks))
+        text = ('<?xml version="1.0"?>\n<VTKFile type="PUnstructuredGrid" version="0.1" byte_order="LittleEndian">\n'
+                '<PUnstructuredGrid GhostLevel="0">\n<PPointData>\n' + columns + '</PPointData>\n'
+                '<PPoints>\n<PDataArray type="Float64" Name="Points" NumberOfComponents="3"/>\n</PPoints>\n'
+                + pieces + '</PUnstructuredGrid>\n</VTKFile>\n')
+        with naming(self.folder / file):
+            (self.folder / file).write_text(text)
+        self.frames.append((t, file))
+        self.written = number           # (every rank waited for its piece before this one's)
+        if time.monotonic() - self._indexed >= self.INDEX_EVERY:
+            self._index()
+        return self.folder / file
+
+    def write(self, t: float, points, **point_data) -> Path:
+        raise RuntimeError("a PieceSeries' frames are written by every rank: write_piece, then add")
+
+    def flush(self) -> None:
+        """Every frame so far in the index: the caller had every rank wait for its pieces."""
+        self.written = len(self.frames)
+        self._index()
+
+    def _index(self) -> None:
+        listed, self.frames = self.frames, self.frames[:self.written]
+        try:
+            super()._index()
+        finally:
+            self.frames = listed
+
+
+def _vtu_type(a: np.ndarray) -> str:
+    import meshio.vtu._vtu as vtu
+    return vtu.numpy_to_vtu_type[np.dtype(a.dtype)]
+
+
+def _components(a: np.ndarray) -> int:
+    return int(np.prod(a.shape[1:], dtype=np.int64)) if a.ndim > 1 else 1
 
 
 class Progress:

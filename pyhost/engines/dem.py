@@ -403,17 +403,20 @@ class Dem:
         return cols
 
     @collective
-    def each_rank(self, func, *args) -> list:
+    def each_rank(self, func, *args, temperature: bool | None = None) -> list:
         """``func(atoms, events, comm, *args)`` (a module-level function: the followers import it
-        by name) on every rank, on its own atoms (``local_view``: LIGGGHTS' memory, T writable)
-        and contact events; the ranks' results in rank order (serially: the one result, in a
-        list, comm None). What the host changed in gathered atoms goes back first."""
+        by name) on every rank, on its own atoms (``local_view``: LIGGGHTS' memory, T writable;
+        ``temperature`` False or, by default, a run without heat: T None, LIGGGHTS has no Temp
+        then) and contact events (None if not recorded); the ranks' results in rank order
+        (serially: the one result, in a list, comm None). What the host changed in gathered
+        atoms goes back first."""
         ENGINE[0] = self.lmp            # (ranks.ENGINE: for a func that needs more than the atoms)
+        temperature = self.heat if temperature is None else temperature
         if self.link is None:
-            return [func(local_view(self.lmp, self.heat), self.events, None, *args)]
-        self._order("each_rank", func, args, self.heat)    # (T None without heat: LIGGGHTS has no Temp then)
-        mine = func(local_view(self.lmp, self.heat), None if self.events is None else self.events.local,
-                    self.link.comm, *args)
+            return [func(local_view(self.lmp, temperature), self.events, None, *args)]
+        self._order("each_rank", func, args, temperature)
+        events = self.events.local if self.events is not None else None
+        mine = func(local_view(self.lmp, temperature), events, self.link.comm, *args)
         self._pending = None            # func may change the atoms' Temp: a gathered copy is out of date
         return self.link.gather(mine)
 

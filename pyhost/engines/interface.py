@@ -163,10 +163,11 @@ class DemEngine(Protocol):
     def snapshot(self) -> tuple:
         """The copies of ``keep_snapshot``: (ids, x, v) of all particles (a report of lost ones)."""
 
-    def each_rank(self, func, *args) -> list:
+    def each_rank(self, func, *args, temperature: bool | None = None) -> list:
         """``func(atoms, events, comm, *args)`` run where the particles live: each MPI rank on its
-        own atoms (``Atoms`` with T writable into the engine) and contact events, serially once
-        with comm None; the results in rank order."""
+        own atoms (``Atoms`` with T writable into the engine; without T where ``temperature`` is
+        False or, by default, the run has no heat) and contact events, serially once with comm
+        None; the results in rank order."""
 
     def per_atom(self, names) -> tuple:
         """Per-atom arrays by name ("id", "f", "torque"), for a checkpoint."""

@@ -92,6 +92,44 @@ def gather_arrays(comm, arrays) -> tuple:
     return (tuple(joined), counts) if comm.Get_rank() == ROOT else (None, None)
 
 
+class Broadcast:
+    """A numpy array rank 0 sends to every rank by MPI's typed ``Bcast`` inside a collective
+    call (``Dem.each_rank``'s function calls :meth:`get`): an order's arguments are pickled
+    (``Link.order``), and this object pickles to its shape and dtype only, so a per-id table
+    of the host (O(N)) is not pickled with the order. Serially (comm None) it is the array."""
+
+    def __init__(self, array):
+        self.array = np.ascontiguousarray(array)
+        self.shape, self.dtype = self.array.shape, self.array.dtype.str
+
+    def __getstate__(self):
+        return dict(shape=self.shape, dtype=self.dtype)
+
+    def __setstate__(self, state):
+        self.array, self.shape, self.dtype = None, state["shape"], state["dtype"]
+
+    def get(self, comm) -> np.ndarray:
+        """The array on every rank (collective under MPI: every rank calls it)."""
+        if comm is None:
+            return self.array
+        buf = _plain(self.array) if comm.Get_rank() == ROOT else np.empty(self.shape, np.dtype(self.dtype).char)
+        if buf.size:
+            comm.Bcast(buf, root=ROOT)
+        return buf
+
+
+def sum_bits(comm, bits: np.ndarray) -> np.ndarray | None:
+    """The bitwise OR of every rank's uint8 ``bits`` (the same length on all ranks), on rank 0
+    (None elsewhere); serially the bits. Collective."""
+    if comm is None:
+        return bits
+    from mpi4py import MPI
+    bits = _plain(np.ascontiguousarray(bits, np.uint8))
+    out = np.empty_like(bits) if comm.Get_rank() == ROOT else None
+    comm.Reduce(bits, out, op=MPI.BOR, root=ROOT)
+    return out
+
+
 def local_values(lmp, names) -> tuple:
     """Copies of these per-atom arrays of this rank's atoms (``Liggghts.atom`` names)."""
     return tuple(lmp.atom(name).copy() for name in names)

@@ -68,6 +68,46 @@ def test_contact_events_of_a_pair_across_the_rank_boundary_equal_the_serial_run(
         assert (tmp_path / "np2" / name).read_bytes() == (tmp_path / "np1" / name).read_bytes(), name
 
 
+def test_frames_written_in_pieces_on_two_ranks_are_the_serial_frames(tmp_path):
+    """The pair across the cut without restitution feedback (nothing then changes a velocity
+    but LIGGGHTS, on either rank count): every frame of the two-rank run, written in pieces
+    (each rank its own particle, rank 0 the .pvtu), read back equals the serial run's .vtu
+    bit for bit once sorted by id (``assert_frames_equal``); history.csv too."""
+    case = pair_across_the_boundary(tmp_path)
+    toml = case / "case.toml"
+    assert "restitution_feedback = true" in toml.read_text()
+    toml.write_text(toml.read_text().replace("restitution_feedback = true", "restitution_feedback = false")
+                    + "pictures = false\n")
+    serial = run(case, tmp_path / "np1", 1)
+    run(case, tmp_path / "np2", 2)
+    assert serial["collisions"] == 1
+    assert (tmp_path / "np2" / "history.csv").read_bytes() == (tmp_path / "np1" / "history.csv").read_bytes()
+    assert_frames_equal(tmp_path / "np1" / "vtk", tmp_path / "np2" / "vtk", ranks=2)
+
+
+def assert_frames_equal(serial, parallel, ranks):
+    """The frames of a run on ``ranks`` ranks, each written in pieces (one .vtu per rank, a
+    .pvtu naming them, the .pvd listing the .pvtu files), read back by pyvista: the serial
+    run's frames (one .vtu each), point for point once sorted by id, every array bit for bit,
+    at the same times."""
+    import pyvista
+
+    one, many = pyvista.get_reader(str(serial / "particles.pvd")), pyvista.get_reader(str(parallel / "particles.pvd"))
+    assert many.time_values == one.time_values and len(one.time_values) > 2
+    files = sorted(p.name for p in parallel.glob("particles_*"))
+    frames = len(one.time_values)
+    assert files == sorted([f"particles_{k:05d}.pvtu" for k in range(frames)]
+                           + [f"particles_{k:05d}_p{r}.vtu" for k in range(frames) for r in range(ranks)])
+    for k in range(frames):
+        a, b = (pyvista.read(str(folder / name)) for folder, name in
+                ((serial, f"particles_{k:05d}.vtu"), (parallel, f"particles_{k:05d}.pvtu")))
+        assert sorted(a.point_data.keys()) == sorted(b.point_data.keys())
+        ia, ib = np.argsort(a["id"]), np.argsort(b["id"])
+        assert np.array_equal(a.points[ia], b.points[ib]), k
+        for name in a.point_data.keys():
+            assert b[name].dtype == a[name].dtype and np.array_equal(a[name][ia], b[name][ib]), (k, name)
+
+
 @pytest.mark.long
 def test_granular_gas_on_two_ranks(tmp_path):
     """hot-cold-box's smoke run (1000 spheres, periodic): the same collisions within the

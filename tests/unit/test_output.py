@@ -10,8 +10,8 @@ import pytest
 import pyvista
 
 from pyhost.effects.collisions import COLLISION_COLUMNS
-from pyhost.output import (ColumnLog, CsvLog, Progress, VtkSeries, collision_kinds, collisions_to_csv,
-                           read_collisions, read_columns)
+from pyhost.output import (ColumnLog, CsvLog, PieceSeries, Progress, VtkSeries, collision_kinds, collisions_to_csv,
+                           read_collisions, read_columns, wait_piece, write_piece)
 
 
 def test_csv_rows_are_on_disk_before_close(tmp_path):
@@ -75,6 +75,43 @@ def test_vtk_series_readable_after_each_frame(tmp_path):
         mesh = reader.read()[0]
         assert mesh.n_points == 7
         assert np.allclose(mesh.points, x) and np.all(mesh.point_data["temperature"] == 300.0 + k)
+
+
+def test_frames_in_pieces_read_back_whole_and_a_restart_keeps_only_its_frames(tmp_path):
+    """A frame written in pieces (one .vtu per MPI rank, here both written by this process as
+    ranks 0 and 1 would) reads back through its .pvtu, and the .pvd lists the .pvtu files, as
+    one mesh: the pieces' points in rank order, every array as written (dtype included); the
+    dumps reader reads the .pvtu too. A restart from a checkpoint after the first frame (here on
+    one rank) removes the later frame's .pvtu and pieces and keeps the first's."""
+    from pyhost.dumps import DumpReader
+
+    rng = np.random.default_rng(1)
+    series = PieceSeries(tmp_path, "particles", 2)
+    written = []
+    for k in range(2):
+        parts = [dict(x=rng.uniform(size=(n, 3)), id=np.arange(n) + 10 * r + 1, type=np.full(n, 1, np.int32),
+                      radius=np.full(n, 1e-3), v=rng.normal(size=(n, 3))) for r, n in enumerate((5, 3 + k))]
+        for r, p in enumerate(parts):
+            write_piece(tmp_path, "particles", series.next_frame(), r, p["x"], id=p["id"], type=p["type"],
+                        radius=p["radius"], v=p["v"])
+        wait_piece(tmp_path, "particles")
+        series.add(0.1 * k, {name: parts[0][name][:0] for name in ("id", "type", "radius", "v")})
+        written.append(parts)
+    series.flush()
+    reader = pyvista.get_reader(str(tmp_path / "particles.pvd"))
+    assert reader.time_values == pytest.approx([0.0, 0.1])
+    for k, parts in enumerate(written):
+        mesh = pyvista.read(str(tmp_path / f"particles_{k:05d}.pvtu"))
+        assert np.array_equal(mesh.points, np.concatenate([p["x"] for p in parts]))
+        for name in ("id", "type", "radius", "v"):
+            whole = np.concatenate([p[name] for p in parts])
+            assert mesh[name].dtype == whole.dtype and np.array_equal(mesh[name], whole), name
+    frame = next(iter(DumpReader([tmp_path / "particles_00001.pvtu"])))
+    assert np.array_equal(frame["id"], np.concatenate([p["id"] for p in written[1]]))
+    VtkSeries(tmp_path, "particles", frames=[(0.0, "particles_00000.pvtu")])        # (continued on one rank)
+    assert sorted(p.name for p in tmp_path.glob("particles_*")) == [
+        "particles_00000.pvtu", "particles_00000_p0.vtu", "particles_00000_p1.vtu"]
+    assert pyvista.get_reader(str(tmp_path / "particles.pvd")).time_values == pytest.approx([0.0])
 
 
 def test_progress_line():
