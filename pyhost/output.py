@@ -531,12 +531,13 @@ def piece_name(name: str, frame: int, rank: int) -> str:
     return f"{name}_{frame:05d}_p{rank}.vtu"
 
 
-def piece_mesh(points, point_data: dict):
-    """Points [m] with per-point arrays as a meshio mesh of vertices, copied (the caller's may
-    be the engine's memory, which the next chunk changes)."""
+def piece_mesh(points, point_data: dict) -> tuple:
+    """Points [m] with per-point arrays as a mesh of vertices (``_write_frame``'s points, cells
+    and point data), copied (the caller's may be the engine's memory, which the next chunk
+    changes)."""
     points = np.array(points, float).reshape(-1, 3)
     cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
-    return meshio.Mesh(points, cells, point_data={k: np.array(v) for k, v in point_data.items()})
+    return points, cells, {k: np.array(v) for k, v in point_data.items()}
 
 
 _pieces = {}        # (folder, name) -> this rank's piece being written (write_piece)
@@ -550,7 +551,7 @@ def write_piece(folder, name: str, frame: int, rank: int, points, **point_data) 
     has said so: ``wait_piece``)."""
     wait_piece(folder, name)
     path = Path(folder) / piece_name(name, frame, rank)
-    _pieces[str(folder), name] = _output_writer().submit(_write_frame, path, piece_mesh(points, point_data))
+    _pieces[str(folder), name] = _output_writer().submit(_write_frame, path, *piece_mesh(points, point_data))
 
 
 def wait_piece(folder, name: str) -> None:

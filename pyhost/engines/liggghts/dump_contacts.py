@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyhost.collisions import FirstAppearances, contact_keys, minimum_image
+from pyhost.collisions import FirstAppearances, Found, contact_keys, minimum_image
 from pyhost.dumps import DumpError, DumpReader, expand, local_compute, processor_parts
 from pyhost.output import Progress
 
