@@ -175,6 +175,15 @@ class EnergyBalance(Effect):
         self.CT0 = t.pop("energy_in")
         t["energy_in"] = 0.0
 
+    def _grow(self, top: int) -> None:
+        """The tables by id long enough for ids below ``top`` (at least doubled when they grow)."""
+        if top > len(self.seen):
+            grow = max(top, 2 * len(self.seen)) - len(self.seen)
+            self.seen = np.r_[self.seen, np.zeros(grow, bool)]
+            self.CT_by_id = np.r_[self.CT_by_id, np.zeros(grow)]
+            self.M_by_id = np.r_[self.M_by_id, np.zeros(grow)]
+            self.T_first_by_id = np.r_[self.T_first_by_id, np.full(grow, np.nan)]
+
     def track(self, atoms, departures: bool = True) -> None:
         """Inserted particles: their material's temperature (if the scene gives one) and their
         heat content enters the balance; departed ones (deleted, lost) leave it with the heat
@@ -186,13 +195,7 @@ class EnergyBalance(Effect):
         absent ones have not departed."""
         loop, totals = self.loop, self.loop.totals
         ids = atoms.id
-        top = int(ids.max(initial=0)) + 1
-        if top > len(self.seen):
-            grow = max(top, 2 * len(self.seen)) - len(self.seen)
-            self.seen = np.r_[self.seen, np.zeros(grow, bool)]
-            self.CT_by_id = np.r_[self.CT_by_id, np.zeros(grow)]
-            self.M_by_id = np.r_[self.M_by_id, np.zeros(grow)]
-            self.T_first_by_id = np.r_[self.T_first_by_id, np.full(grow, np.nan)]
+        self._grow(int(ids.max(initial=0)) + 1)
         mat = loop.materials_of(atoms.type)
         C = atoms.mass * loop.capacity[mat]
         new = ~self.seen[ids]
@@ -271,14 +274,8 @@ class EnergyBalance(Effect):
             totals["energy_set_by_script"] += sum(p.get("set_by_script", 0.0) for p in parts)
         present = np.unpackbits(parts[0]["present"], count=len(self.seen)).astype(bool)
         new_ids = np.concatenate([p["new_ids"] for p in parts])
-        top = int(new_ids.max(initial=0)) + 1
         gone = self.seen & ~present
-        if top > len(self.seen):
-            grow = max(top, 2 * len(self.seen)) - len(self.seen)
-            self.seen = np.r_[self.seen, np.zeros(grow, bool)]
-            self.CT_by_id = np.r_[self.CT_by_id, np.zeros(grow)]
-            self.M_by_id = np.r_[self.M_by_id, np.zeros(grow)]
-            self.T_first_by_id = np.r_[self.T_first_by_id, np.full(grow, np.nan)]
+        self._grow(int(new_ids.max(initial=0)) + 1)
         if len(new_ids):
             totals["inserted"] += len(new_ids)
             totals["energy_in"] += sum(p["energy_in"] for p in parts)
