@@ -210,7 +210,7 @@ def render_particles(out: Path) -> Path:
                 ) if sprites else {}
     plotter.add_mesh(spheres, scalars="change", cmap="coolwarm", clim=clim,
                      scalar_bar_args=dict(bar, title=f"T change [{unit}]\n", position_x=0.86, fmt="%.3g")
-                     if has_fluid else {"title": title}, **size)
+                     if has_fluid else {"title": title + "\n"}, **size)   # (the newline: the title clear of the labels)
     if has_fluid:
         b = np.array(grid.bounds).reshape(3, 2)
         depth = 0 if b[0, 1] - b[0, 0] < b[1, 1] - b[1, 0] else 1    # the thin horizontal axis: seen across
