@@ -238,13 +238,7 @@ class FluidExchange(Effect):
             inlet = self.inlet(loop.t) if self.inlet is not None else math.nan
         else:
             inlet = float(loop.scene.fluid.inlet_at(loop.t))
-        if self.grid is not None:       # summed on each rank (pyhost.engines.fluid_ranks)
-            from pyhost.engines.fluid_ranks import height_on_rank
-            parts = loop.dem.each_rank(height_on_rank, up, floor)
-            total, n = sum(p[0] for p in parts), sum(p[1] for p in parts)
-            height = 2.0 * (total / n) if n else math.nan
-        else:
-            height = 2.0 * float(np.mean(atoms.x @ up - floor)) if len(atoms.x) else math.nan
+        height = 2.0 * float(np.mean(atoms.x @ up - floor)) if len(atoms.x) else math.nan
         return inlet, layer_pressure_drop(self.fluid, up) + head, height
 
     def gas_state(self) -> tuple:

@@ -201,12 +201,6 @@ def _summed(comm, values: np.ndarray) -> np.ndarray | None:
     return total
 
 
-def height_on_rank(atoms, events, comm, up, floor) -> tuple[float, int]:
-    """``Dem.each_rank``: this rank's particle centre heights along ``up`` above ``floor`` [m]
-    summed, and their number (the history's bed height)."""
-    return float(np.sum(atoms.x @ up - floor)), len(atoms.x)
-
-
 def force_on_rank(atoms, events, comm, fix: str) -> tuple[np.ndarray, np.ndarray]:
     """``Dem.each_rank``: this rank's atom ids and the fluid's force on them [N] (LIGGGHTS' ``fix``
     external's array: a checkpoint)."""

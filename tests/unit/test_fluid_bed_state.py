@@ -33,7 +33,7 @@ def column(axis: int, sign: float):
         x[:, axis] = H - x[:, axis]                             # ...or the upper, under gravity along +axis
     loop = SimpleNamespace(scene=SimpleNamespace(fluid=SimpleNamespace(case="fluid")), t=0.0,
                            dem=SimpleNamespace(box=lambda: (np.zeros(3), np.full(3, H), np.zeros(3, bool))))
-    return SimpleNamespace(loop=loop, fluid=fluid, up=upwards(fluid), inlet=None, grid=None), SimpleNamespace(x=x)
+    return SimpleNamespace(loop=loop, fluid=fluid, up=upwards(fluid), inlet=None), SimpleNamespace(x=x)
 
 
 @pytest.mark.parametrize("axis, sign", [(2, -1.0), (1, -1.0), (0, 1.0)])
