@@ -19,6 +19,7 @@ import importlib
 import json
 import math
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -455,6 +456,15 @@ def _write_frame(path: Path, points, cells, point_data) -> None:
         raise
 
 
+def vertex_mesh(points, point_data: dict) -> tuple:
+    """Points [m] with per-point arrays as a mesh of vertices (``_write_frame``'s points, cells
+    and point data), copied (the caller's may be the engine's memory, which the next chunk
+    changes): a frame of a ``VtkSeries``, or a rank's piece of one."""
+    points = np.array(points, float).reshape(-1, 3)
+    cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
+    return points, cells, {k: np.array(v) for k, v in point_data.items()}
+
+
 class VtkSeries:
     """Points with data, one file per frame, and the .pvd index of the frames so far.
     ``frames``: those of a checkpoint to continue from; later frame files are removed.
@@ -480,7 +490,6 @@ class VtkSeries:
         """The frame files a checkpoint's frames do not name (written after it) removed: .vtu
         frames, and .pvtu frames with their pieces (``PieceSeries``: a checkpoint of a run on
         several ranks may go on on one, and the other way round)."""
-        import re
         stems = {Path(f).stem for f in kept}
         for old in sorted(self.folder.glob(f"{self.name}_*.vtu")) + sorted(self.folder.glob(f"{self.name}_*.pvtu")):
             piece = re.fullmatch(r"(.*_\d{5})_p\d+", old.stem)       # a rank's piece of a frame
@@ -492,10 +501,7 @@ class VtkSeries:
         may be the engine's memory, which the next chunk changes)."""
         self._wait()
         file = f"{self.name}_{len(self.frames):05d}.vtu"
-        points = np.array(points, float)
-        cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
-        self._pending = _output_writer().submit(_write_frame, self.folder / file, points, cells,
-                                                {k: np.array(v) for k, v in point_data.items()})
+        self._pending = _output_writer().submit(_write_frame, self.folder / file, *vertex_mesh(points, point_data))
         self.frames.append((t, file))
         if time.monotonic() - self._indexed >= self.INDEX_EVERY:
             self._index()
@@ -531,15 +537,6 @@ def piece_name(name: str, frame: int, rank: int) -> str:
     return f"{name}_{frame:05d}_p{rank}.vtu"
 
 
-def piece_mesh(points, point_data: dict) -> tuple:
-    """Points [m] with per-point arrays as a mesh of vertices (``_write_frame``'s points, cells
-    and point data), copied (the caller's may be the engine's memory, which the next chunk
-    changes)."""
-    points = np.array(points, float).reshape(-1, 3)
-    cells = [("vertex", np.arange(len(points)).reshape(-1, 1))]
-    return points, cells, {k: np.array(v) for k, v in point_data.items()}
-
-
 _pieces = {}        # (folder, name) -> this rank's piece being written (write_piece)
 
 
@@ -551,7 +548,7 @@ def write_piece(folder, name: str, frame: int, rank: int, points, **point_data) 
     has said so: ``wait_piece``)."""
     wait_piece(folder, name)
     path = Path(folder) / piece_name(name, frame, rank)
-    _pieces[str(folder), name] = _output_writer().submit(_write_frame, path, *piece_mesh(points, point_data))
+    _pieces[str(folder), name] = _output_writer().submit(_write_frame, path, *vertex_mesh(points, point_data))
 
 
 def wait_piece(folder, name: str) -> None:

@@ -25,6 +25,12 @@ class HostWall:
     mesh: int = 0
 
 
+def lookup(table: np.ndarray, keys) -> np.ndarray:
+    """``table``'s entry for each of ``keys`` (ids or types), a key beyond the table taking its
+    last entry (the tables of ``Known`` and ``TypeMaterials``, and their copies on the ranks)."""
+    return table[np.minimum(keys, len(table) - 1)]
+
+
 @dataclass(frozen=True)
 class Known:
     """What the host knows of each particle before LIGGGHTS holds it, by atom id (a box scene:
@@ -41,7 +47,7 @@ class Known:
 
     def of(self, table: np.ndarray, atoms, mask=slice(None)) -> np.ndarray:
         """``table``'s entry (``group`` or ``T``) for each atom (of ``mask``)."""
-        return table[np.minimum(getattr(atoms, self.by)[mask], len(table) - 1)]
+        return lookup(table, getattr(atoms, self.by)[mask])
 
 
 class TypeMaterials:
@@ -56,7 +62,7 @@ class TypeMaterials:
         """Material index of each of ``types``; ScriptError naming the types that have none."""
         table = self.table
         types = np.asarray(types)
-        mat = np.where(types < len(table), table[np.minimum(types, len(table) - 1)], -1)
+        mat = np.where(types < len(table), lookup(table, types), -1)
         if (mat < 0).any():
             bad = sorted(set(types[mat < 0].tolist()))
             raise ScriptError(f"{self.where}: atom type(s) {bad} have no material: name them in a "

@@ -26,6 +26,7 @@ import numpy as np
 from pyhost.effects import Effect, by_id
 from pyhost.engines.liggghts.script import ScriptError
 from pyhost.engines.ranks import Broadcast, sum_bits
+from pyhost.tables import lookup
 
 RANK_EFFECTS = {"balance", "collisions", "frames"}
 """The effects with which, under MPI, the balance and the frames work on each rank's own atoms
@@ -89,7 +90,7 @@ def track_on_rank(atoms, events, comm, spec: RankTrack) -> dict:
     known_T = spec.known_T.get(comm) if isinstance(spec.known_T, Broadcast) else spec.known_T
     ids, T, mass, types = atoms.id, atoms.T, atoms.mass, atoms.type
     table = spec.type_material
-    mat = np.where(types < len(table), table[np.minimum(types, len(table) - 1)], -1)
+    mat = np.where(types < len(table), lookup(table, types), -1)
     bits = np.zeros(len(seen), bool)
     inside = ids < len(seen)
     bits[ids[inside]] = True

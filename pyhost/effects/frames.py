@@ -22,6 +22,7 @@ from pyhost.effects import Effect
 from pyhost.effects.balance import rank_effects_only
 from pyhost.engines.ranks import Broadcast
 from pyhost.output import CsvLog, PieceSeries, VtkSeries, wait_piece, write_piece
+from pyhost.tables import lookup
 
 FRAME_EVERY = 1e-3
 """s between frames where output.every is 0 and the script has no dump (box scenes: always)."""
@@ -62,11 +63,10 @@ def frame_on_rank(atoms, events, comm, spec: RankFrame) -> dict:
     n = len(atoms.id)
     if spec.heat:
         T = atoms.T
-        table = spec.type_material
-        C = atoms.mass * spec.capacity[table[np.minimum(atoms.type, len(table) - 1)]]
+        C = atoms.mass * spec.capacity[lookup(spec.type_material, atoms.type)]
     else:
         T, C = np.full(n, np.nan), np.ones(n)
-    group = group_table[np.minimum(getattr(atoms, "id" if spec.known_by == "id" else "type"), len(group_table) - 1)]
+    group = lookup(group_table, getattr(atoms, spec.known_by))
     groups = [(float(np.sum(C[g] * T[g])), float(np.sum(C[g])), bool(g.any()))
               for g in (group == k for k in range(spec.groups))]
     arrays = None
@@ -177,9 +177,7 @@ class Frames(Effect):
                          Broadcast(balance.T_first_by_id) if heat and series is not None else None)
         parts = loop.dem.each_rank(frame_on_rank, spec, temperature=heat)
         n = sum(p["n"] for p in parts)
-        if n == 0:
-            stats = (math.nan,) * 3
-        elif any(p["nan"] for p in parts):
+        if n == 0 or any(p["nan"] for p in parts):
             stats = (math.nan,) * 3
         else:
             stats = (sum(p["T_sum"] for p in parts) / n, min(p["T_min"] for p in parts), max(p["T_max"] for p in parts))
