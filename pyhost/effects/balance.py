@@ -110,7 +110,7 @@ def track_on_rank(atoms, events, comm, spec: RankTrack) -> dict:
     T_entry = T[new].copy()
     if new.any():
         key = ids if spec.known_by == "id" else types
-        T_set = known_T[np.minimum(key[new], len(known_T) - 1)]
+        T_set = lookup(known_T, key[new])
         T[new] += np.where(np.isnan(T_set), 0.0, T_set - T_entry)
         T_entry = np.where(np.isnan(T_set), T_entry, T_set)
         cold = np.flatnonzero(~(T[new] > 0))

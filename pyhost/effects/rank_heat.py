@@ -35,6 +35,7 @@ import numpy as np
 
 from pyhost.collisions import Bodies, collide, log_wall, material_of
 from pyhost.engines.events import BEGIN, END
+from pyhost.tables import lookup
 
 
 @dataclass(frozen=True)
@@ -102,7 +103,7 @@ def on_rank(atoms, events, comm, setup: RankHeat) -> dict:
         involved = np.zeros(top, bool)
         involved[np.r_[i[begun], j_atom[begun], wanted[wanted < top]]] = True
         fresh = np.flatnonzero(involved[ids] & ~seen[ids] & (material >= 0))
-        T_set = setup.T_of_type[np.minimum(types[fresh], len(setup.T_of_type) - 1)]
+        T_set = lookup(setup.T_of_type, types[fresh])
         result_new = (ids[fresh], mass[fresh].copy(), types[fresh].copy(), radius[fresh].copy(), T[fresh].copy())
         T[fresh] = np.where(np.isnan(T_set), T[fresh], T_set)
         seen[ids[fresh]] = True
